@@ -1,0 +1,15 @@
+//! The fluid side of FIVER: a vertex-centred, edge-based finite-volume solver of the compressible
+//! Euler equations on arbitrary non-body-fitted grids (thesis Ch. 2), growing towards the embedded
+//! boundary of Ch. 4-5.
+//!
+//! Modules follow the discretisation: `eos` -> `mesh` (geometry and connectivity only, never
+//! solver state) -> `riemann`, `flux`, `reconstruct`, `bc` -> `semidiscretization` (the residual)
+//! -> `time` -> `output`, `probes`. Must not touch: the structure, the IPC transport (it talks to
+//! the structure only through `interface-protocol` endpoints).
+#![deny(unsafe_op_in_unsafe_fn)]
+
+pub mod eos;
+pub mod flux;
+pub mod mesh;
+pub mod reconstruct;
+pub mod riemann;

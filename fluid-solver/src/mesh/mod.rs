@@ -1,0 +1,1 @@
+//! Grids: geometry and connectivity only.

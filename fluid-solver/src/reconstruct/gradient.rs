@@ -1,0 +1,1 @@
+//! Nodal least-squares gradients.

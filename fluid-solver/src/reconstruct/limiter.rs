@@ -1,0 +1,1 @@
+//! Slope limiters.

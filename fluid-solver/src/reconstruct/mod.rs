@@ -1,0 +1,4 @@
+//! MUSCL reconstruction of primitive variables at edge midpoints (thesis §2.3).
+
+pub mod gradient;
+pub mod limiter;

@@ -1,0 +1,15 @@
+//! The contract between the FSI solvers: the `#[repr(C)]` messages that cross iceoryx2 shared
+//! memory, the endpoints that hide iceoryx2 from solver code, the coupling formulas of the
+//! staggered schemes, the case-file parser shared by all executables and (feature `io`) the run
+//! outputs both solvers write.
+//!
+//! Owns: message layout, service names, handshake, liveness, case parsing, coupling formulas.
+//! Must not touch: fluid or structure physics; it stays light enough for foreign peers and the
+//! rigid-body solver.
+#![deny(unsafe_op_in_unsafe_fn)]
+
+pub mod case;
+pub mod messages;
+
+#[cfg(feature = "io")]
+pub mod io;

@@ -1,0 +1,10 @@
+//! The structure side of FIVER: a nonlinear finite-element solver for shells, beams, solids and
+//! rigid parts with large displacements and rotations (DESIGN §6), explicit and implicit in time.
+//!
+//! Modules: `mesh` (generators, gmsh reader, sets) -> `material` (elastic, J2) -> `elements`
+//! (corotational shells, beams, tets, rigid) -> `assembly` (a `Model` for the integrators) ->
+//! `time` (central difference, implicit midpoint, Newmark), `statics`. Must not touch: the fluid,
+//! the IPC transport (coupling goes through `interface-protocol` endpoints).
+#![deny(unsafe_op_in_unsafe_fn)]
+
+pub mod model;

@@ -1,0 +1,6 @@
+//! `structure-solver`: runs a case alone or as a coupled participant.
+
+fn main() {
+    eprintln!("structure-solver: no command is available in this build yet");
+    std::process::exit(2);
+}
