@@ -98,6 +98,20 @@ impl Default for Command {
     }
 }
 
+/// Values of `Command::scheme_phase` for an `Advance` (the sequence is in `coupling`).
+pub mod scheme_phase {
+    /// Fluid advances, and any command that is not an `Advance`.
+    pub const NONE: u32 = 0;
+    /// Structure: take the loads `F^0` the fluid computed at `Init`, start the scheme (C0:
+    /// publish the kinematics predicted for `t^{1/2}`). Fluid (C0 only): the start-up half step.
+    pub const START: u32 = 1;
+    /// Structure: advance what can be advanced without the new load and publish the kinematics the
+    /// fluid's next `Advance` needs.
+    pub const PREDICT: u32 = 2;
+    /// Structure: take the load the fluid just returned and complete the step.
+    pub const CORRECT: u32 = 3;
+}
+
 /// Kinds of `Reply::kind`.
 pub mod reply_kind {
     pub const READY: u32 = 1;
