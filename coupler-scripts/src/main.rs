@@ -1,6 +1,100 @@
 //! `fsi`: starts the two solvers of a case, supervises them and sequences the coupling scheme.
 
-fn main() {
-    eprintln!("fsi: no command is available in this build yet");
-    std::process::exit(2);
+use clap::{Parser, Subcommand};
+use coupler_scripts::run::{run, RunOptions};
+use coupler_scripts::{check, plot};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Fluid-structure interaction launcher (FIVER).
+#[derive(Debug, Parser)]
+#[command(name = "fsi", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Debug, Subcommand)]
+enum Cmd {
+    /// Runs a coupled case: starts both participants and drives the coupling scheme.
+    Run {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Output folder (default: the case's output.dir, else runs/<case>-<timestamp>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Overrides a case key, e.g. --set coupling.dt=1e-4 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+        /// No progress bar and no messages but errors.
+        #[arg(long)]
+        quiet: bool,
+        /// Reuse a non-empty output folder, removing the previous run's files.
+        #[arg(long)]
+        force: bool,
+        /// Run id naming the run's shared memory (default: generated; for scripts and tests).
+        #[arg(long)]
+        run_id: Option<String>,
+    },
+    /// Parses and validates a case without running it.
+    Check {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Overrides a case key, as for `run`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        overrides: Vec<String>,
+    },
+    /// Writes PNG plots of a run folder's probe files into DIR/plots.
+    Plot {
+        /// A run folder (holding probes.csv and/or structure_probes.csv).
+        dir: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Cmd::Run { case, out, overrides, quiet, force, run_id } => {
+            let opts = RunOptions { case_file: case, out, overrides, quiet, force, run_id };
+            match run(&opts) {
+                Ok(s) => {
+                    if !quiet {
+                        eprintln!(
+                            "fsi: completed {} steps in {:.2} s; outputs in {}",
+                            s.steps,
+                            s.wall.as_secs_f64(),
+                            s.out_dir.display()
+                        );
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("fsi: error: {e}");
+                    ExitCode::from(e.exit_code().clamp(1, 255) as u8)
+                }
+            }
+        }
+        Cmd::Check { case, overrides } => match check::check(&case, &overrides) {
+            Ok(summary) => {
+                print!("{summary}");
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("fsi: error: {e}");
+                ExitCode::from(2)
+            }
+        },
+        Cmd::Plot { dir } => match plot::plot_dir(&dir) {
+            Ok(files) => {
+                for f in files {
+                    println!("{}", f.display());
+                }
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("fsi: error: {e}");
+                ExitCode::FAILURE
+            }
+        },
+    }
 }

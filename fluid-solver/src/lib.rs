@@ -1,15 +1,21 @@
 //! The fluid side of FIVER: a vertex-centred, edge-based finite-volume solver of the compressible
-//! Euler equations on arbitrary non-body-fitted grids (thesis Ch. 2), growing towards the embedded
-//! boundary of Ch. 4-5.
+//! Euler equations on arbitrary non-body-fitted grids (thesis Ch. 2-3), growing towards the
+//! embedded boundary of Ch. 4-5.
 //!
 //! Modules follow the discretisation: `eos` -> `mesh` (geometry and connectivity only, never
-//! solver state) -> `riemann`, `flux`, `reconstruct`, `bc` -> `semidiscretization` (the residual)
-//! -> `time` -> `output`, `probes`. Must not touch: the structure, the IPC transport (it talks to
-//! the structure only through `interface-protocol` endpoints).
+//! solver state) -> `riemann`, `flux`, `reconstruct`, `bc` -> `state`, `initial` ->
+//! `semidiscretization` (the residual) -> `time` -> `solver` (the run loop) with `output`,
+//! `probes`. Must not touch: the structure, the IPC transport (it talks to the structure only
+//! through `interface-protocol` endpoints).
 #![deny(unsafe_op_in_unsafe_fn)]
 
+pub mod bc;
 pub mod eos;
 pub mod flux;
+pub mod initial;
 pub mod mesh;
 pub mod reconstruct;
 pub mod riemann;
+pub mod semidiscretization;
+pub mod state;
+pub mod time;

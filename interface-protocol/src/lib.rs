@@ -9,7 +9,14 @@
 #![deny(unsafe_op_in_unsafe_fn)]
 
 pub mod case;
+pub mod coupling;
+pub mod endpoint;
+pub mod handshake;
+pub mod liveness;
 pub mod messages;
+pub mod participant;
+pub mod services;
+pub mod shm;
 
 #[cfg(feature = "io")]
 pub mod io;

@@ -3,8 +3,15 @@
 //!
 //! Modules: `mesh` (generators, gmsh reader, sets) -> `material` (elastic, J2) -> `elements`
 //! (corotational shells, beams, tets, rigid) -> `assembly` (a `Model` for the integrators) ->
-//! `time` (central difference, implicit midpoint, Newmark), `statics`. Must not touch: the fluid,
-//! the IPC transport (coupling goes through `interface-protocol` endpoints).
+//! `time` (central difference, implicit midpoint, Newmark), `statics`, `modal`. Must not touch:
+//! the fluid, the IPC transport (coupling goes through `interface-protocol` endpoints).
 #![deny(unsafe_op_in_unsafe_fn)]
 
+pub mod assembly;
+pub mod elements;
+pub mod material;
+pub mod mesh;
+pub mod modal;
 pub mod model;
+pub mod statics;
+pub mod time;

@@ -2,3 +2,4 @@
 
 pub mod gradient;
 pub mod limiter;
+pub mod muscl;

@@ -1,5 +1,6 @@
-//! `[fluid.piston]`: an acoustic column closed by a piston face, F = -A (p0 + ρ0 c0 v) (linear
-//! acoustics, the face moving with normal velocity v into the column).
+//! `[fluid.piston]`: an acoustic column closed by a piston face, F = -A (p0 + ρ0 c0 v·n) n (linear
+//! acoustics: a face moving into the column with normal velocity v·n raises the pressure by the
+//! impedance ρ0 c0 times it; no reflection comes back from the column, which is semi-infinite).
 
 use serde::Deserialize;
 
@@ -15,9 +16,16 @@ pub struct PistonFluid {
     pub rho0: f64,
     /// Sound speed c0 [m/s].
     pub c0: f64,
-    /// Unit normal of the face pointing out of the fluid (into the piston); default +x.
+    /// Unit normal of the face pointing from the piston into the fluid column; default +x.
     #[serde(default = "default_normal")]
     pub normal: [f64; 3],
+    /// Name of the face in `probes.csv`.
+    #[serde(default = "default_probe")]
+    pub probe: String,
+}
+
+fn default_probe() -> String {
+    "face".to_string()
 }
 
 fn default_normal() -> [f64; 3] {

@@ -1,0 +1,444 @@
+//! `fsi run`: one coupled run from start to `run.json` (DESIGN §1, §3, §7).
+//!
+//! The launcher opens the run's services, starts both participants, waits for and checks their
+//! `Hello`s, then sends the scheme's commands one by one. Every wait is cut into slices of
+//! [`SLICE`]; between slices it polls both children and its own termination signals, so a dead
+//! participant, a silent one or Ctrl-C ends the run within about a second, with both children
+//! gone and the run's shared memory removed.
+
+use crate::scheme::{Progress, SchemeError, SchemeSettings, Sequencer};
+use crate::supervise::{Death, LaunchArgs, Participant, Participants, SpawnError};
+use interface_protocol::case::Case;
+use interface_protocol::endpoint::{LauncherLink, ProtocolError, Timeouts};
+use interface_protocol::io::outdir::{default_run_dir, OutputDir, Policy};
+use interface_protocol::io::progress::Progress as Bar;
+use interface_protocol::io::report::{self, case_echo, RunReport};
+use interface_protocol::liveness;
+use interface_protocol::messages::{Command, Hello, Reply, Role};
+use interface_protocol::shm;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// Longest wait between two checks of the children and of signals.
+pub const SLICE: Duration = Duration::from_millis(20);
+
+/// After a failure, how long to look for a child death that explains it.
+const DEATH_GRACE: Duration = Duration::from_millis(300);
+
+/// What `fsi run` was asked to do.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    pub case_file: PathBuf,
+    pub out: Option<PathBuf>,
+    pub overrides: Vec<String>,
+    pub quiet: bool,
+    pub force: bool,
+    /// Run id (services and shared-memory files); generated when `None`.
+    pub run_id: Option<String>,
+}
+
+/// Why a run stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("{0}")]
+    Case(#[from] interface_protocol::case::CaseError),
+    #[error("{0}")]
+    Scheme(#[from] SchemeError),
+    #[error("{0}")]
+    Setup(String),
+    #[error("{0}")]
+    Spawn(#[from] SpawnError),
+    #[error("{death} before the run finished{}", waiting.as_deref().map(|w| format!(", while waiting for {w}")).unwrap_or_default())]
+    Died { death: Death, waiting: Option<String> },
+    #[error("{who} did not {what} within {timeout_s} s (coupling.timeout_s)")]
+    Silent { who: String, what: String, timeout_s: f64 },
+    #[error("{0}")]
+    Protocol(#[from] ProtocolError),
+    #[error("stopped by {}", crate::supervise::signal_name(*.0))]
+    Interrupted(i32),
+    #[error("after Finish: {0}")]
+    BadExit(String),
+}
+
+impl RunError {
+    /// Process exit code: 128 + signal when interrupted, 1 otherwise.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            RunError::Interrupted(sig) => 128 + sig,
+            _ => 1,
+        }
+    }
+}
+
+/// Per-participant totals of the `Done` replies.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+struct SolverTime {
+    work_s: f64,
+    wait_s: f64,
+}
+
+/// What `run.json` holds beyond the common report.
+#[derive(Debug, Serialize)]
+struct LauncherReport<'a> {
+    #[serde(flatten)]
+    report: &'a RunReport,
+    run_id: &'a str,
+    scheme: String,
+    dt: f64,
+    t_end: f64,
+    overrides: &'a [String],
+    /// The structure's energy ledger (`energy.json` in the run folder), when it writes one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    energy: Option<serde_json::Value>,
+}
+
+/// A fresh run id: `r<pid>-<nanoseconds>` in hex (unique per process and instant).
+pub fn new_run_id() -> String {
+    let nanos = SystemTime::now().duration_since(UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0);
+    format!("r{:x}-{:x}", std::process::id(), nanos as u64)
+}
+
+/// Result of a completed run.
+#[derive(Debug)]
+pub struct RunSummary {
+    pub out_dir: PathBuf,
+    pub steps: u64,
+    pub wall: Duration,
+}
+
+/// The live state of one run.
+struct Session<'a> {
+    link: Option<LauncherLink>,
+    children: Participants,
+    timeout: Duration,
+    timeout_s: f64,
+    ipc_wait: Duration,
+    solver: BTreeMap<&'static str, SolverTime>,
+    bar: &'a mut Bar,
+}
+
+/// Runs a case; `run.json` is written in the output folder whether the run completes or not.
+pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
+    let start = Instant::now();
+    liveness::install_signal_handlers();
+    let case = Case::load(&opts.case_file, &opts.overrides)?;
+    let settings = SchemeSettings::of_case(&case);
+    let mut seq = Sequencer::new(settings)?;
+    let fluid_cmd = case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
+    let structure_cmd =
+        case.structure.as_ref().map(|s| s.command()).unwrap_or_else(|| vec!["structure-solver".into()]);
+
+    let dir = match (&opts.out, &case.output.dir) {
+        (Some(d), _) => d.clone(),
+        (None, Some(d)) => PathBuf::from(d),
+        (None, None) => default_run_dir(&opts.case_file, SystemTime::now()),
+    };
+    let out = OutputDir::create(&dir, Policy::from_force(opts.force))
+        .map_err(|e| RunError::Setup(e.to_string()))?;
+    let out_dir = std::fs::canonicalize(out.path()).unwrap_or_else(|_| out.path().to_path_buf());
+    let case_file = std::fs::canonicalize(&opts.case_file).unwrap_or_else(|_| opts.case_file.clone());
+    let run_id = opts.run_id.clone().unwrap_or_else(new_run_id);
+
+    let mut bar = Bar::new(settings.t_end, opts.quiet);
+    bar.println(&format!(
+        "fsi: run {run_id}: {} ({:?}, dt {:e}, {} steps) -> {}",
+        case.case.name,
+        settings.scheme,
+        settings.dt,
+        settings.n_steps,
+        out_dir.display()
+    ));
+    let mut session = Session {
+        link: None,
+        children: Participants::default(),
+        timeout: Duration::from_secs_f64(case.coupling.timeout_s),
+        timeout_s: case.coupling.timeout_s,
+        ipc_wait: Duration::ZERO,
+        solver: BTreeMap::new(),
+        bar: &mut bar,
+    };
+    let args = LaunchArgs {
+        case_file: &case_file,
+        run_id: &run_id,
+        out_dir: &out_dir,
+        overrides: &opts.overrides,
+    };
+    let mut steps = 0;
+    let result = session
+        .start(&run_id, &args, &structure_cmd, &fluid_cmd, case.hash())
+        .and_then(|()| session.drive(&mut seq, &mut steps))
+        .and_then(|()| session.wait_exits());
+    let result = match result {
+        Err(e) => Err(session.explain(e)),
+        ok => ok,
+    };
+    session.children.stop_all();
+    let cleaned = match session.link.take() {
+        Some(link) => link.remove_resources(),
+        None => shm::cleanup_run(&run_id),
+    };
+    let (ipc_wait, solver) = (session.ipc_wait, session.solver.clone());
+    drop(session);
+    let wall = start.elapsed();
+    let status = match (&result, &cleaned) {
+        (Err(e), _) => e.to_string(),
+        (Ok(()), Err(e)) => format!("completed, but the run's shared memory was not removed: {e}"),
+        (Ok(()), Ok(_)) => "completed".to_string(),
+    };
+    let final_time = if steps == 0 { 0.0 } else { seq.time(steps) };
+    let reported = write_report(
+        &out,
+        &case,
+        opts,
+        &run_id,
+        &status,
+        (steps, final_time),
+        (wall, ipc_wait, &solver),
+    );
+    bar.finish();
+    result?;
+    cleaned?;
+    reported.map_err(|e| RunError::Setup(format!("cannot write {}: {e}", out.run_json().display())))?;
+    Ok(RunSummary { out_dir, steps, wall })
+}
+
+impl Session<'_> {
+    /// Opens the link, starts both children, waits for and checks their `Hello`s.
+    fn start(
+        &mut self,
+        run_id: &str,
+        args: &LaunchArgs,
+        structure_cmd: &[String],
+        fluid_cmd: &[String],
+        case_hash: u64,
+    ) -> Result<(), RunError> {
+        self.link = Some(LauncherLink::open(run_id, Timeouts::from_secs(self.timeout_s))?);
+        self.children.push(Participant::spawn(Role::Structure, structure_cmd, args)?);
+        self.children.push(Participant::spawn(Role::Fluid, fluid_cmd, args)?);
+        let deadline = Instant::now() + self.timeout;
+        let structure = self.hello(Role::Structure, deadline)?;
+        let fluid = self.hello(Role::Fluid, deadline)?;
+        LauncherLink::check(&fluid, &structure, case_hash)?;
+        Ok(())
+    }
+
+    fn hello(&mut self, role: Role, deadline: Instant) -> Result<Hello, RunError> {
+        let what = "send its Hello (is it a coupling participant?)".to_string();
+        self.in_slices(role, deadline, what, |link, until| link.wait_hello(role, until))
+    }
+
+    /// Sends the scheme's commands until both participants acknowledged `Finish`.
+    fn drive(&mut self, seq: &mut Sequencer, steps: &mut u64) -> Result<(), RunError> {
+        while let Some((role, cmd)) = seq.next() {
+            let reply = self.command(role, &cmd)?;
+            let progress = match seq.accept(role, &reply) {
+                Err(e @ SchemeError::Failed { .. }) => {
+                    self.children.release(role);
+                    self.finish_other(role);
+                    return Err(e.into());
+                }
+                other => other?,
+            };
+            self.account(role, &reply);
+            if cmd.kind == interface_protocol::messages::command_kind::FINISH {
+                self.children.release(role);
+            }
+            match progress {
+                Progress::StepDone { step, t } => {
+                    *steps = step + 1;
+                    self.bar.update(step + 1, t, seq.step_dt(step));
+                }
+                Progress::Finished | Progress::Continue => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// Sends one command and waits for its reply (deadline `coupling.timeout_s`).
+    fn command(&mut self, role: Role, cmd: &Command) -> Result<Reply, RunError> {
+        self.check_alive()?;
+        let link = self.link.as_mut().expect("the link is open while commands are sent");
+        link.send(role, cmd)?;
+        let deadline = Instant::now() + self.timeout;
+        let what = format!("answer {}", cmd.describe());
+        let waited = Instant::now();
+        let reply = self.in_slices(role, deadline, what, |link, until| link.wait_reply(role, until));
+        self.ipc_wait += waited.elapsed();
+        reply
+    }
+
+    /// After `failed` answered `Failed`: `Finish` to the other participant, best effort.
+    fn finish_other(&mut self, failed: Role) {
+        let other = if failed == Role::Fluid { Role::Structure } else { Role::Fluid };
+        if self.command(other, &Command::finish()).is_ok() {
+            self.children.release(other);
+        }
+        self.children.wait_all(Instant::now() + Duration::from_secs(1));
+    }
+
+    /// Adds a `Done` reply's timings to the participant's totals.
+    fn account(&mut self, role: Role, reply: &Reply) {
+        let t = self.solver.entry(role.name()).or_default();
+        t.work_s += reply.work_s.max(0.0);
+        t.wait_s += reply.wait_s.max(0.0);
+    }
+
+    /// After `Finish`: every child exits, with code 0, within `coupling.timeout_s`.
+    fn wait_exits(&mut self) -> Result<(), RunError> {
+        let deadline = Instant::now() + self.timeout;
+        loop {
+            self.check_signal()?;
+            let running = self.children.wait_all(Instant::now() + SLICE);
+            if running.is_empty() {
+                break;
+            }
+            if Instant::now() >= deadline {
+                let who: Vec<String> = running.iter().map(|p| p.label()).collect();
+                return Err(RunError::Silent {
+                    who: who.join(" and "),
+                    what: "exit after Finish".into(),
+                    timeout_s: self.timeout_s,
+                });
+            }
+        }
+        let bad: Vec<String> = self
+            .children
+            .exits()
+            .into_iter()
+            .filter(|(_, _, s)| !s.success())
+            .map(|(_, label, s)| format!("{label} {}", crate::supervise::describe_exit(s)))
+            .collect();
+        if bad.is_empty() {
+            Ok(())
+        } else {
+            Err(RunError::BadExit(bad.join("; ")))
+        }
+    }
+
+    fn check_signal(&self) -> Result<(), RunError> {
+        match liveness::termination_signal() {
+            Some(sig) => Err(RunError::Interrupted(sig)),
+            None => Ok(()),
+        }
+    }
+
+    fn check_alive(&mut self) -> Result<(), RunError> {
+        self.check_signal()?;
+        match self.children.first_dead() {
+            Some(death) => Err(RunError::Died { death, waiting: None }),
+            None => Ok(()),
+        }
+    }
+
+    /// Calls `wait` with deadlines of at most `SLICE` until it yields or `deadline` passes,
+    /// checking signals and both children between slices. `role` is who is awaited.
+    fn in_slices<T>(
+        &mut self,
+        role: Role,
+        deadline: Instant,
+        what: String,
+        mut wait: impl FnMut(&mut LauncherLink, Instant) -> Result<T, ProtocolError>,
+    ) -> Result<T, RunError> {
+        let who = self.children.get(role).map_or_else(|| role.name().to_string(), |p| {
+            format!("the {} participant {}", role.name(), p.label())
+        });
+        loop {
+            match self.check_alive() {
+                Err(RunError::Died { death, .. }) => {
+                    let waiting = (death.role != role).then(|| format!("{who} to {what}"));
+                    return Err(RunError::Died { death, waiting });
+                }
+                other => other?,
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(RunError::Silent { who, what, timeout_s: self.timeout_s });
+            }
+            let link = self.link.as_mut().expect("the link is open while waiting");
+            match wait(link, (now + SLICE).min(deadline)) {
+                Ok(v) => return Ok(v),
+                Err(ProtocolError::Timeout { .. }) => {}
+                Err(ProtocolError::Terminated { signal }) => return Err(RunError::Interrupted(signal)),
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+
+    /// A protocol error right after a child died is explained by the death: report that.
+    fn explain(&mut self, e: RunError) -> RunError {
+        if matches!(e, RunError::Died { .. } | RunError::Interrupted(_) | RunError::Case(_)) {
+            return e;
+        }
+        let until = Instant::now() + DEATH_GRACE;
+        loop {
+            if let Some(d) = self.children.first_dead() {
+                return RunError::Died { death: d, waiting: None };
+            }
+            if Instant::now() >= until {
+                return e;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
+
+/// Writes `run.json`: the common report plus the launcher's view (run id, scheme, overrides,
+/// the structure's energy ledger when present).
+fn write_report(
+    out: &OutputDir,
+    case: &Case,
+    opts: &RunOptions,
+    run_id: &str,
+    status: &str,
+    (steps, final_time): (u64, f64),
+    (wall, ipc_wait, solver): (Duration, Duration, &BTreeMap<&'static str, SolverTime>),
+) -> std::io::Result<()> {
+    let text = std::fs::read_to_string(&opts.case_file).unwrap_or_default();
+    let mut versions = report::versions();
+    versions.insert("coupler-scripts".into(), env!("CARGO_PKG_VERSION").into());
+    let mut timings = BTreeMap::new();
+    for (role, t) in solver {
+        timings.insert(
+            role.to_string(),
+            BTreeMap::from([("work".to_string(), t.work_s), ("ipc_wait".to_string(), t.wait_s)]),
+        );
+    }
+    timings.insert(
+        "launcher".to_string(),
+        BTreeMap::from([
+            ("ipc_wait".to_string(), ipc_wait.as_secs_f64()),
+            ("total".to_string(), wall.as_secs_f64()),
+        ]),
+    );
+    let report = RunReport {
+        case_file: opts.case_file.display().to_string(),
+        case: case_echo(&text).unwrap_or(serde_json::Value::Null),
+        versions,
+        status: status.to_string(),
+        steps,
+        final_time,
+        counts: BTreeMap::from([("coupling_steps".to_string(), case.coupling.n_steps())]),
+        wall_seconds: wall.as_secs_f64(),
+        timings,
+    };
+    let energy = read_json(&out.path().join("energy.json"));
+    let full = LauncherReport {
+        report: &report,
+        run_id,
+        scheme: format!("{:?}", case.coupling.scheme),
+        dt: case.coupling.dt,
+        t_end: case.coupling.t_end,
+        overrides: &opts.overrides,
+        energy,
+    };
+    interface_protocol::io::atomic::write_atomic(&out.run_json(), |w| {
+        serde_json::to_writer_pretty(&mut *w, &full).map_err(std::io::Error::other)?;
+        std::io::Write::write_all(w, b"\n")
+    })
+}
+
+fn read_json(path: &Path) -> Option<serde_json::Value> {
+    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
+}

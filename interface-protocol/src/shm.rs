@@ -1,0 +1,129 @@
+//! Shared-memory housekeeping (DESIGN §3): room in `/dev/shm` before allocating (a full tmpfs
+//! shows up later as SIGBUS), removal of every file of a run, and of runs whose nodes all died.
+
+use crate::endpoint::ProtocolError;
+use crate::services;
+use iceoryx2::prelude::{ipc, CallbackProgression, Node, NodeState};
+use std::path::{Path, PathBuf};
+
+/// Where iceoryx2 maps its shared memory.
+pub const SHM_DIR: &str = "/dev/shm";
+/// Where iceoryx2 keeps its node and service descriptions (`Config::global.root_path`).
+pub const ROOT_DIR: &str = "/tmp/iceoryx2";
+
+/// Free bytes of the file system holding `dir`.
+pub fn free_bytes(dir: &Path) -> Result<u64, ProtocolError> {
+    let c = std::ffi::CString::new(dir.as_os_str().as_encoded_bytes())
+        .map_err(|_| ProtocolError::Setup(format!("bad path {}", dir.display())))?;
+    // SAFETY: `statvfs` writes into the zeroed struct we own; `c` is a valid C string.
+    let (rc, st) = unsafe {
+        let mut st: libc::statvfs = std::mem::zeroed();
+        (libc::statvfs(c.as_ptr(), &mut st), st)
+    };
+    if rc != 0 {
+        return Err(ProtocolError::Setup(format!(
+            "cannot query free space of {}: {}",
+            dir.display(),
+            std::io::Error::last_os_error()
+        )));
+    }
+    Ok(st.f_bavail as u64 * st.f_frsize as u64)
+}
+
+/// Fails with a clear message unless `/dev/shm` has room for `bytes` (`what` names the buffer).
+pub fn ensure_capacity(bytes: u64, what: &str) -> Result<(), ProtocolError> {
+    let free = free_bytes(Path::new(SHM_DIR))?;
+    if bytes > free {
+        return Err(ProtocolError::Setup(format!(
+            "{SHM_DIR} has {} MiB free but {what} needs {} MiB: free space there or enlarge the \
+             tmpfs (mount -o remount,size=...)",
+            free >> 20,
+            bytes.div_ceil(1 << 20)
+        )));
+    }
+    Ok(())
+}
+
+/// Every file of a run: in `/dev/shm` and (recursively) under `/tmp/iceoryx2`.
+pub fn run_files(run_id: &str) -> Vec<PathBuf> {
+    let prefix = services::prefix(run_id);
+    let mut out = Vec::new();
+    collect(Path::new(SHM_DIR), &prefix, false, &mut out);
+    collect(Path::new(ROOT_DIR), &prefix, true, &mut out);
+    out
+}
+
+fn collect(dir: &Path, prefix: &str, recursive: bool, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let path = e.path();
+        let is_dir = e.file_type().is_ok_and(|t| t.is_dir());
+        if e.file_name().to_string_lossy().starts_with(prefix) {
+            out.push(path);
+        } else if recursive && is_dir {
+            collect(&path, prefix, true, out);
+        }
+    }
+}
+
+/// Removes every file of a run (call it only when no process of the run is alive). Returns the
+/// number of files removed.
+pub fn cleanup_run(run_id: &str) -> Result<usize, ProtocolError> {
+    services::validate_run_id(run_id)?;
+    let mut removed = 0;
+    for path in run_files(run_id) {
+        let r = if path.is_dir() { std::fs::remove_dir_all(&path) } else { std::fs::remove_file(&path) };
+        match r {
+            Ok(()) => removed += 1,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => {
+                return Err(ProtocolError::Setup(format!("cannot remove {}: {e}", path.display())))
+            }
+        }
+    }
+    Ok(removed)
+}
+
+/// Run ids that own files in `/dev/shm` or `/tmp/iceoryx2`.
+pub fn runs_on_disk() -> Vec<String> {
+    let mut ids = std::collections::BTreeSet::new();
+    for dir in [Path::new(SHM_DIR), Path::new(ROOT_DIR)] {
+        let mut files = Vec::new();
+        collect(dir, "fsi_", true, &mut files);
+        for f in files {
+            let name = f.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            if let Some(id) = name.strip_prefix("fsi_").and_then(|r| r.split('_').next()) {
+                if services::validate_run_id(id).is_ok() {
+                    ids.insert(id.to_string());
+                }
+            }
+        }
+    }
+    ids.into_iter().collect()
+}
+
+/// Whether any node of the run is alive (or cannot be inspected, which counts as alive).
+pub fn run_has_live_node(run_id: &str) -> bool {
+    let Ok(config) = services::config(run_id) else { return false };
+    let mut alive = false;
+    let listed = Node::<ipc::Service>::list(&config, |state| {
+        if !matches!(state, NodeState::Dead(_)) {
+            alive = true;
+            return CallbackProgression::Stop;
+        }
+        CallbackProgression::Continue
+    });
+    alive || listed.is_err()
+}
+
+/// Removes the files of every run whose nodes are all dead (DESIGN §3: stale resources of dead
+/// runs are cleaned at start). Returns the run ids cleaned.
+pub fn cleanup_stale_runs() -> Vec<String> {
+    let mut cleaned = Vec::new();
+    for id in runs_on_disk() {
+        if !run_has_live_node(&id) && cleanup_run(&id).is_ok() {
+            cleaned.push(id);
+        }
+    }
+    cleaned
+}

@@ -1,0 +1,273 @@
+//! The rigid structure through the coupling sequence (coupling-sequence, DESIGN §4): the scheme's
+//! structure state (`coupling::Staggered`) on the body's DOFs, prescribed DOFs imposed, loads
+//! reduced from the wet nodes, kinematics written in place into the shared buffer.
+
+use crate::model::Body;
+use crate::probes::Probes;
+use interface_protocol::case::{Case, Scheme};
+use interface_protocol::coupling::Staggered;
+use interface_protocol::endpoint::StructureEndpoint;
+use interface_protocol::messages::{scheme_phase, Command, NodeLoad, StepHeader};
+use interface_protocol::participant::{failure_code, Failure, Handler, Progress};
+use std::path::PathBuf;
+
+/// The rigid structure's state.
+pub struct RigidSolver {
+    pub body: Body,
+    pub state: Staggered,
+    /// Scratch for reduced loads.
+    load: Vec<f64>,
+    /// Time the state `u`, `v`, `a` refers to.
+    pub t: f64,
+    probes: Probes,
+    probes_every: u64,
+    out: PathBuf,
+    /// Length of the first coupling step (Δt, or t_end if that is shorter).
+    first_dt: f64,
+}
+
+fn io_failure(what: &str, e: std::io::Error) -> Failure {
+    Failure::new(failure_code::IO, format!("{what}: {e}"))
+}
+
+impl RigidSolver {
+    /// The solver of a case's `[structure.rigid]` writing into `out`.
+    pub fn new(case: &Case, out: PathBuf) -> Result<RigidSolver, String> {
+        let rigid = case
+            .structure
+            .as_ref()
+            .and_then(|s| s.rigid.as_ref())
+            .ok_or_else(|| format!("{}: rigid-structure needs a [structure.rigid] section", case.source.path.display()))?;
+        let body = Body::new(rigid);
+        let mut state = Staggered::new(case.coupling.scheme, &body.u0, &body.v0);
+        body.impose(0.0, &mut state.u, &mut state.v, Some(&mut state.a));
+        let probes = Probes::create(&out, &body.probe)
+            .map_err(|e| format!("cannot create {}/structure_probes.csv: {e}", out.display()))?;
+        Ok(RigidSolver {
+            load: vec![0.0; body.dofs.len()],
+            body,
+            state,
+            t: 0.0,
+            probes,
+            probes_every: case.output.probes_every,
+            out,
+            first_dt: case.coupling.dt.min(case.coupling.t_end),
+        })
+    }
+
+    /// Number of wet nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.body.wet_nodes.len()
+    }
+
+    /// The stable coupling step of the scheme's structure integrator.
+    pub fn dt_stable(&self) -> f64 {
+        match self.state.scheme {
+            Scheme::A6 => f64::INFINITY,
+            Scheme::Css | Scheme::C0 => self.body.dt_stable_explicit(),
+        }
+    }
+
+    /// START with the generalized load F^0 in `self.load`; returns whether a prediction is due.
+    fn start(&mut self, dt: f64) -> bool {
+        let publish = self.state.start(&self.body.dynamics, &self.load, dt);
+        let s = &mut self.state;
+        self.body.impose(0.0, &mut s.u, &mut s.v, Some(&mut s.a));
+        self.body.impose(0.5 * dt, &mut s.up, &mut s.vp, None);
+        publish
+    }
+
+    /// PREDICT of the step [t_from, t_from + dt]; `load` carries F^{1/2} at C0's first step.
+    fn predict(&mut self, t_from: f64, dt: f64, with_load: bool) -> f64 {
+        let load = with_load.then_some(self.load.as_slice());
+        self.state.predict(dt, load);
+        // The time the prediction stands for (CSS: the held state t^n).
+        let target = match self.state.scheme {
+            Scheme::Css => t_from,
+            Scheme::C0 => t_from + 1.5 * dt,
+            Scheme::A6 => t_from + 0.5 * dt,
+        };
+        let s = &mut self.state;
+        self.body.impose(target, &mut s.up, &mut s.vp, None);
+        target
+    }
+
+    /// CORRECT with the generalized load in `self.load`; the state reaches `t_to`.
+    fn correct(&mut self, t_to: f64, dt: f64) {
+        self.state.correct(&self.body.dynamics, &self.load, dt);
+        let s = &mut self.state;
+        self.body.impose(t_to, &mut s.u, &mut s.v, Some(&mut s.a));
+        self.t = t_to;
+    }
+
+    /// Writes the probe row of the current state.
+    fn write_probe(&mut self) -> Result<(), Failure> {
+        let (u, v) = (self.body.full(&self.state.u), self.body.full(&self.state.v));
+        self.probes
+            .row(self.t, [u[0], u[1], u[2]], [v[0], v[1], v[2]])
+            .map_err(|e| io_failure("cannot write structure_probes.csv", e))
+    }
+
+    /// Integrates alone from 0 to `t_end` with zero fluid load, the scheme's structure integrator
+    /// (central difference for CSS and C0, implicit midpoint for A6).
+    pub fn run_alone(&mut self, dt: f64, n_steps: u64, t_end: f64) -> Result<(), Failure> {
+        self.write_probe()?;
+        self.load.fill(0.0);
+        self.start(dt);
+        for step in 0..n_steps {
+            let t_from = step as f64 * dt;
+            let t_to = if step + 1 == n_steps { t_end } else { t_from + dt };
+            self.load.fill(0.0);
+            self.predict(t_from, t_to - t_from, self.state.predict_reads_load(step));
+            self.correct(t_to, t_to - t_from);
+            if (step + 1) % self.probes_every == 0 || step + 1 == n_steps {
+                self.write_probe()?;
+            }
+        }
+        self.probes.flush().map_err(|e| io_failure("cannot write structure_probes.csv", e))
+    }
+
+    /// Publishes the kinematics (`up`, `vp` when `predicted`, else `u`, `v`) for time `t`.
+    fn publish(&self, ep: &mut StructureEndpoint, step: u64, t: f64, dt: f64, predicted: bool) -> Result<(), Failure> {
+        let (u, v) = if predicted { (&self.state.up, &self.state.vp) } else { (&self.state.u, &self.state.v) };
+        let header = StepHeader { step, time: t, dt, topology_version: 1, count: 0 };
+        ep.publish_kinematics(header, self.n_nodes(), |nodes| self.body.node_states(u, v, nodes))?;
+        Ok(())
+    }
+
+    /// Reads the fluid's loads into `self.load` (generalized, at the current state).
+    fn read_loads(&mut self, ep: &mut StructureEndpoint) -> Result<(), Failure> {
+        let n = self.n_nodes();
+        let (body, u, load) = (&self.body, &self.state.u, &mut self.load);
+        let count = ep.read_loads(|_, loads: &[NodeLoad]| {
+            if loads.len() == n {
+                body.reduce(u, loads, load);
+            }
+            loads.len()
+        })?;
+        if count != n {
+            return Err(Failure::new(
+                failure_code::PROTOCOL,
+                format!("the fluid sent {count} nodal loads, the structure has {n} wet nodes"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Handler<StructureEndpoint> for RigidSolver {
+    fn init(&mut self, ep: &mut StructureEndpoint) -> Result<f64, Failure> {
+        let header = StepHeader { step: 0, time: 0.0, dt: 0.0, topology_version: 1, count: 0 };
+        let elements = &self.body.elements;
+        ep.publish_topology(header, elements.len(), |out| out.copy_from_slice(elements))?;
+        self.publish(ep, 0, 0.0, 0.0, false)?;
+        self.write_probe()?;
+        Ok(self.dt_stable())
+    }
+
+    fn advance(&mut self, ep: &mut StructureEndpoint, c: &Command) -> Result<Progress, Failure> {
+        let dt = c.t_to - c.t_from;
+        match c.scheme_phase {
+            scheme_phase::START => {
+                // START carries t_from = t_to = 0: the first step's Δt comes from the case.
+                self.read_loads(ep)?;
+                if self.start(self.first_dt) {
+                    self.publish(ep, 0, 0.5 * self.first_dt, self.first_dt, true)?;
+                }
+            }
+            scheme_phase::PREDICT => {
+                let with_load = self.state.predict_reads_load(c.step);
+                if with_load {
+                    self.read_loads(ep)?;
+                }
+                let target = self.predict(c.t_from, dt, with_load);
+                self.publish(ep, c.step, target, dt, true)?;
+            }
+            scheme_phase::CORRECT => {
+                self.read_loads(ep)?;
+                self.correct(c.t_to, dt);
+                if (c.step + 1) % self.probes_every == 0 {
+                    self.write_probe()?;
+                }
+            }
+            p => {
+                return Err(Failure::new(
+                    failure_code::UNSUPPORTED,
+                    format!("the structure has no Advance phase {p} (expected START, PREDICT or CORRECT)"),
+                ))
+            }
+        }
+        Ok(Progress { step: c.step, t: self.t, dt_stable: self.dt_stable() })
+    }
+
+    fn checkpoint(&mut self, _ep: &mut StructureEndpoint, tag: &str) -> Result<(), Failure> {
+        let dir = self.out.join("checkpoints").join(tag);
+        std::fs::create_dir_all(&dir).map_err(|e| io_failure("cannot create the checkpoint folder", e))?;
+        let mut text = format!("# rigid-structure state at t = {:.17e}\ndof,u,v,a\n", self.t);
+        for (i, &d) in self.body.dofs.iter().enumerate() {
+            let s = &self.state;
+            text += &format!("{},{:.17e},{:.17e},{:.17e}\n", interface_protocol::case::RIGID_DOFS[d], s.u[i], s.v[i], s.a[i]);
+        }
+        self.probes.flush().map_err(|e| io_failure("cannot write structure_probes.csv", e))?;
+        std::fs::write(dir.join("rigid-structure.csv"), text).map_err(|e| io_failure("cannot write the checkpoint", e))
+    }
+
+    fn finish(&mut self, _ep: &mut StructureEndpoint) -> Result<(), Failure> {
+        self.probes.flush().map_err(|e| io_failure("cannot write structure_probes.csv", e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// m u'' + c u' + k u = 0, u(0) = u0, u'(0) = 0: the closed form.
+    fn damped(m: f64, k: f64, c: f64, u0: f64, t: f64) -> f64 {
+        let g = c / (2.0 * m);
+        let wd = (k / m - g * g).sqrt();
+        u0 * (-g * t).exp() * ((wd * t).cos() + g / wd * (wd * t).sin())
+    }
+
+    fn case(scheme: &str, dt: f64, extra: &str) -> Case {
+        let text = format!(
+            "[coupling]\nscheme = \"{scheme}\"\ndt = {dt:e}\nt_end = 1.0\n[structure.rigid]\nmass = 2.0\n\
+             stiffness = 50.0\ndamping = 0.8\nu0 = 0.01\n{extra}"
+        );
+        Case::parse(&text, Path::new("case.toml"), &[]).unwrap()
+    }
+
+    fn final_error(scheme: &str, dt: f64) -> f64 {
+        let dir = tempfile::tempdir().unwrap();
+        let c = case(scheme, dt, "");
+        let mut s = RigidSolver::new(&c, dir.path().to_path_buf()).unwrap();
+        s.run_alone(dt, c.coupling.n_steps(), 1.0).unwrap();
+        assert_eq!(s.t, 1.0);
+        (s.state.u[0] - damped(2.0, 50.0, 0.8, 0.01, 1.0)).abs()
+    }
+
+    #[test]
+    fn central_difference_and_implicit_midpoint_converge_at_second_order() {
+        for scheme in ["C0", "CSS", "A6"] {
+            let e: Vec<f64> = [4e-3, 2e-3, 1e-3].iter().map(|&dt| final_error(scheme, dt)).collect();
+            let p = (e[1] / e[2]).log2();
+            assert!((1.9..2.1).contains(&p), "{scheme}: errors {e:?}, order {p}");
+            assert!(e[2] < 1e-5, "{scheme}: error {}", e[2]);
+        }
+    }
+
+    #[test]
+    fn prescribed_motion_is_followed_exactly_and_probes_are_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let extra = "probe = \"piston\"\n[[structure.rigid.prescribed]]\ndof = \"x\"\namplitude = 0.002\nfrequency = 3.0\n";
+        let c = case("C0", 1e-2, extra);
+        let mut s = RigidSolver::new(&c, dir.path().to_path_buf()).unwrap();
+        s.run_alone(1e-2, c.coupling.n_steps(), 1.0).unwrap();
+        let w = 2.0 * std::f64::consts::PI * 3.0;
+        assert!((s.state.u[0] - 0.002 * (1.0 - (w * 1.0).cos())).abs() < 1e-15);
+        let csv = std::fs::read_to_string(dir.path().join("structure_probes.csv")).unwrap();
+        let mut lines = csv.lines();
+        assert_eq!(lines.next().unwrap(), "time,piston.ux,piston.uy,piston.uz,piston.vx,piston.vy,piston.vz");
+        assert_eq!(lines.count(), 101);
+    }
+}

@@ -1,0 +1,142 @@
+//! Flat 4-node shell for static and implicit runs: the MITC4 assumed transverse shear of
+//! Bathe & Dvorkin (1985, IJNME 21:367) with 2x2 Gauss integration, a membrane with Taylor's
+//! incompatible modes (QM6; Taylor, Beresford & Wilson 1976, IJNME 10:1211) against in-plane
+//! shear locking, and a drilling penalty (`section::DRILL_PENALTY`). Local, small strain: large
+//! rotations come from the corotated frame (`corotation`).
+//!
+//! Local dofs per node `[u, v, w, θx, θy, θz]`; normal rotations `βx = θy`, `βy = -θx`.
+
+use nalgebra::{DMatrix, Matrix2, Vector2};
+
+use super::section::{add_btdb, ShellSection, DRILL_PENALTY};
+
+const XI: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
+const ETA: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
+
+fn shape(xi: f64, eta: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let mut n = [0.0; 4];
+    let mut dxi = [0.0; 4];
+    let mut deta = [0.0; 4];
+    for i in 0..4 {
+        n[i] = 0.25 * (1.0 + XI[i] * xi) * (1.0 + ETA[i] * eta);
+        dxi[i] = 0.25 * XI[i] * (1.0 + ETA[i] * eta);
+        deta[i] = 0.25 * ETA[i] * (1.0 + XI[i] * xi);
+    }
+    (n, dxi, deta)
+}
+
+fn jacobian(xy: &[[f64; 2]; 4], dxi: &[f64; 4], deta: &[f64; 4]) -> Matrix2<f64> {
+    let mut j = Matrix2::zeros();
+    for i in 0..4 {
+        j[(0, 0)] += dxi[i] * xy[i][0];
+        j[(0, 1)] += dxi[i] * xy[i][1];
+        j[(1, 0)] += deta[i] * xy[i][0];
+        j[(1, 1)] += deta[i] * xy[i][1];
+    }
+    j
+}
+
+/// Covariant transverse shear `γ_ξz` (`dir` 0) or `γ_ηz` (`dir` 1) at `(ξ, η)` as a row over
+/// the 24 local dofs.
+fn covariant_shear(xy: &[[f64; 2]; 4], xi: f64, eta: f64, dir: usize) -> [f64; 24] {
+    let (n, dxi, deta) = shape(xi, eta);
+    let j = jacobian(xy, &dxi, &deta);
+    let dn = if dir == 0 { dxi } else { deta };
+    let (xa, ya) = (j[(dir, 0)], j[(dir, 1)]);
+    let mut r = [0.0; 24];
+    for i in 0..4 {
+        r[6 * i + 2] = dn[i];
+        r[6 * i + 4] = n[i] * xa; // βx = θy
+        r[6 * i + 3] = -n[i] * ya; // βy = -θx
+    }
+    r
+}
+
+/// Local 24x24 stiffness of a flat quad with in-plane nodal coordinates `xy` (counter-clockwise).
+pub fn stiffness(xy: &[[f64; 2]; 4], sec: &ShellSection) -> DMatrix<f64> {
+    let to_d = |m: [[f64; 3]; 3]| DMatrix::from_fn(3, 3, |i, j| m[i][j]);
+    let (dm, db) = (to_d(sec.membrane()), to_d(sec.bending()));
+    let ds = DMatrix::from_diagonal_element(2, 2, sec.shear());
+    let g = 1.0 / 3f64.sqrt();
+    let gauss = [(-g, -g), (g, -g), (g, g), (-g, g)];
+    // MITC4 tying points: γ_ξz at A (0, 1), C (0, -1); γ_ηz at D (1, 0), B (-1, 0).
+    let ga = covariant_shear(xy, 0.0, 1.0, 0);
+    let gc = covariant_shear(xy, 0.0, -1.0, 0);
+    let gd = covariant_shear(xy, 1.0, 0.0, 1);
+    let gb = covariant_shear(xy, -1.0, 0.0, 1);
+    let (_, dxi0, deta0) = shape(0.0, 0.0);
+    let j0 = jacobian(xy, &dxi0, &deta0);
+    let (j0inv, det0) = (j0.try_inverse().expect("degenerate quad"), j0.determinant());
+
+    let mut k = DMatrix::zeros(24, 24);
+    let mut kaa = DMatrix::<f64>::zeros(4, 4);
+    let mut kua = DMatrix::<f64>::zeros(24, 4);
+    for &(xi, eta) in &gauss {
+        let (_, dxi, deta) = shape(xi, eta);
+        let j = jacobian(xy, &dxi, &deta);
+        let det = j.determinant();
+        let jinv = j.try_inverse().expect("degenerate quad");
+        let mut bm = DMatrix::zeros(3, 24);
+        let mut bb = DMatrix::zeros(3, 24);
+        for i in 0..4 {
+            let d = jinv * Vector2::new(dxi[i], deta[i]);
+            let (nx, ny) = (d.x, d.y);
+            bm[(0, 6 * i)] = nx;
+            bm[(1, 6 * i + 1)] = ny;
+            bm[(2, 6 * i)] = ny;
+            bm[(2, 6 * i + 1)] = nx;
+            bb[(0, 6 * i + 4)] = nx;
+            bb[(1, 6 * i + 3)] = -ny;
+            bb[(2, 6 * i + 4)] = ny;
+            bb[(2, 6 * i + 3)] = -nx;
+        }
+        let mut bs = DMatrix::zeros(2, 24);
+        for c in 0..24 {
+            let gxi = 0.5 * (1.0 + eta) * ga[c] + 0.5 * (1.0 - eta) * gc[c];
+            let geta = 0.5 * (1.0 + xi) * gd[c] + 0.5 * (1.0 - xi) * gb[c];
+            let cart = jinv * Vector2::new(gxi, geta);
+            bs[(0, c)] = cart.x;
+            bs[(1, c)] = cart.y;
+        }
+        add_btdb(&mut k, &bm, &dm, det);
+        add_btdb(&mut k, &bb, &db, det);
+        add_btdb(&mut k, &bs, &ds, det);
+        // incompatible modes P1 = 1 - ξ², P2 = 1 - η² for u and v, derivatives through J0
+        // scaled by det J0 / det J so that ∫ G dA = 0 (patch test).
+        let p1 = j0inv * Vector2::new(-2.0 * xi, 0.0) * (det0 / det);
+        let p2 = j0inv * Vector2::new(0.0, -2.0 * eta) * (det0 / det);
+        let mut ginc = DMatrix::zeros(3, 4);
+        for (m, p) in [p1, p2].iter().enumerate() {
+            ginc[(0, m)] = p.x;
+            ginc[(1, 2 + m)] = p.y;
+            ginc[(2, m)] = p.y;
+            ginc[(2, 2 + m)] = p.x;
+        }
+        add_btdb(&mut kaa, &ginc, &dm, det);
+        kua.gemm_tr(det, &bm, &(&dm * &ginc), 1.0);
+    }
+    let kaa_inv = kaa.try_inverse().expect("incompatible-mode block is positive definite");
+    k -= &kua * kaa_inv * kua.transpose();
+
+    // drilling penalty: θz_i - ω_c, ω_c = ½(v,x - u,y) at the centroid
+    let area = 4.0 * det0;
+    let kd = DRILL_PENALTY * sec.shear_modulus() * sec.h * area;
+    let mut omega = [0.0; 24];
+    for i in 0..4 {
+        let d = j0inv * Vector2::new(dxi0[i], deta0[i]);
+        omega[6 * i + 1] += 0.5 * d.x;
+        omega[6 * i] -= 0.5 * d.y;
+    }
+    for i in 0..4 {
+        let mut r = omega.map(|v| -v);
+        r[6 * i + 5] += 1.0;
+        let rv = DMatrix::from_row_slice(1, 24, &r);
+        k.gemm_tr(kd, &rv, &rv, 1.0);
+    }
+    k
+}
+
+/// Area of the flat quad.
+pub fn area(xy: &[[f64; 2]; 4]) -> f64 {
+    0.5 * ((xy[2][0] - xy[0][0]) * (xy[3][1] - xy[1][1]) - (xy[3][0] - xy[1][0]) * (xy[2][1] - xy[0][1]))
+}

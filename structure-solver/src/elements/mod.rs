@@ -1,0 +1,15 @@
+//! Finite elements (DESIGN §6): one corotated frame shared by the shells and beams
+//! (`corotation`), the local small-strain elements it carries (`mitc4`, `dkt`, `beam`), the
+//! total-Lagrangian tetrahedron `tet4`, and the element container the assembly loops over.
+
+pub mod beam;
+pub mod corotation;
+pub mod dkt;
+pub mod element;
+pub mod mitc4;
+pub mod rotation;
+pub mod section;
+pub mod tet4;
+
+pub use element::{Element, ElementKind};
+pub use section::{BeamSection, ShellSection};

@@ -1,0 +1,104 @@
+//! Structural meshes: nodes, cells of the element families, and named node and cell sets
+//! (supports, load points, the wet surface). Generators for the benchmark geometries
+//! (`generate`) and a gmsh reader (`gmsh`).
+
+use std::collections::BTreeMap;
+
+pub mod generate;
+pub mod gmsh;
+
+/// Cell shapes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellKind {
+    Line2,
+    Tri3,
+    Quad4,
+    Tet4,
+}
+
+impl CellKind {
+    pub fn n_nodes(self) -> usize {
+        match self {
+            CellKind::Line2 => 2,
+            CellKind::Tri3 => 3,
+            CellKind::Quad4 | CellKind::Tet4 => 4,
+        }
+    }
+}
+
+/// One cell: its shape and node indices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    pub kind: CellKind,
+    pub nodes: Vec<usize>,
+}
+
+/// Nodes, cells and named sets.
+#[derive(Debug, Clone, Default)]
+pub struct Mesh {
+    pub nodes: Vec<[f64; 3]>,
+    pub cells: Vec<Cell>,
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    pub cell_sets: BTreeMap<String, Vec<usize>>,
+}
+
+impl Mesh {
+    /// The nodes of set `name`, or an error naming the set and the ones that exist.
+    pub fn node_set(&self, name: &str) -> Result<&[usize], MeshError> {
+        self.node_sets.get(name).map(|v| v.as_slice()).ok_or_else(|| MeshError::UnknownSet {
+            name: name.to_string(),
+            known: self.node_sets.keys().cloned().collect(),
+        })
+    }
+
+    /// The cells of set `name`.
+    pub fn cell_set(&self, name: &str) -> Result<&[usize], MeshError> {
+        self.cell_sets.get(name).map(|v| v.as_slice()).ok_or_else(|| MeshError::UnknownSet {
+            name: name.to_string(),
+            known: self.cell_sets.keys().cloned().collect(),
+        })
+    }
+
+    /// The node nearest to `p`.
+    pub fn nearest_node(&self, p: [f64; 3]) -> usize {
+        let d2 = |q: &[f64; 3]| (0..3).map(|c| (q[c] - p[c]).powi(2)).sum::<f64>();
+        (0..self.nodes.len()).min_by(|&a, &b| d2(&self.nodes[a]).total_cmp(&d2(&self.nodes[b]))).unwrap_or(0)
+    }
+
+    /// Nodes satisfying `pred`, in index order.
+    pub fn nodes_where(&self, pred: impl Fn(&[f64; 3]) -> bool) -> Vec<usize> {
+        (0..self.nodes.len()).filter(|&i| pred(&self.nodes[i])).collect()
+    }
+
+    /// Splits every quad into two triangles along its 1-3 diagonal; sets keep their cells.
+    pub fn to_triangles(&self) -> Mesh {
+        let mut cells = Vec::new();
+        let mut map = Vec::with_capacity(self.cells.len());
+        for c in &self.cells {
+            let first = cells.len();
+            if c.kind == CellKind::Quad4 {
+                let n = &c.nodes;
+                cells.push(Cell { kind: CellKind::Tri3, nodes: vec![n[0], n[1], n[2]] });
+                cells.push(Cell { kind: CellKind::Tri3, nodes: vec![n[0], n[2], n[3]] });
+            } else {
+                cells.push(c.clone());
+            }
+            map.push(first..cells.len());
+        }
+        let cell_sets = self
+            .cell_sets
+            .iter()
+            .map(|(k, v)| (k.clone(), v.iter().flat_map(|&c| map[c].clone()).collect()))
+            .collect();
+        Mesh { nodes: self.nodes.clone(), cells, node_sets: self.node_sets.clone(), cell_sets }
+    }
+}
+
+/// Mesh errors: reading, unknown sets, unsupported cells.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("unknown set `{name}` (known: {known:?})")]
+    UnknownSet { name: String, known: Vec<String> },
+    #[error("{file}: {message}")]
+    Read { file: String, message: String },
+}

@@ -1,0 +1,275 @@
+//! Static equilibrium of a `Model`: load-stepped Newton-Raphson with a sparse direct solve
+//! (faer LU on the free dofs) and step cutting, and displacement control (Batoz & Dhatt 1979)
+//! for paths with limit points in load. Pseudo-time `t` is the load factor.
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::{SparseColMat, Triplet};
+use faer::Mat;
+
+use crate::model::Model;
+
+/// Newton settings.
+#[derive(Debug, Clone, Copy)]
+pub struct NewtonSettings {
+    /// Relative residual tolerance: `|r_free|∞ <= tol · max(|f_ext|∞, |f_int|∞)`; the floor
+    /// set by round-off in the internal forces of thin shells is about 1e-8.
+    pub tol: f64,
+    /// Iterations per step before the step is cut.
+    pub max_iter: usize,
+    /// Halvings of a step before giving up.
+    pub max_cuts: usize,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        NewtonSettings { tol: 1e-6, max_iter: 30, max_cuts: 8 }
+    }
+}
+
+/// A converged state.
+#[derive(Debug, Clone, Copy)]
+pub struct Converged {
+    /// Load factor (pseudo-time).
+    pub t: f64,
+    /// Newton iterations of the last (sub)step.
+    pub iterations: usize,
+    /// Final relative residual.
+    pub residual: f64,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum StaticsError {
+    #[error("no convergence from t = {from} to t = {to} after {cuts} step cuts (relative residual {residual:.3e})")]
+    NoConvergence { from: f64, to: f64, cuts: usize, residual: f64 },
+    #[error("singular tangent: {0}")]
+    Singular(String),
+    #[error("control dof {0} is constrained or out of range")]
+    BadControl(usize),
+}
+
+/// The free-dof system of a model.
+struct FreeDofs {
+    index: Vec<Option<usize>>,
+    n_free: usize,
+}
+
+impl FreeDofs {
+    fn new(model: &dyn Model) -> Self {
+        let mut n_free = 0;
+        let index = model
+            .constrained()
+            .iter()
+            .map(|&c| {
+                if c {
+                    None
+                } else {
+                    n_free += 1;
+                    Some(n_free - 1)
+                }
+            })
+            .collect();
+        FreeDofs { index, n_free }
+    }
+
+    /// LU of the free-free block of the tangent at `t`.
+    fn factor(&self, model: &mut dyn Model, t: f64) -> Result<faer::sparse::linalg::solvers::Lu<usize, f64>, StaticsError> {
+        let mut trip = Vec::new();
+        model.tangent(t, &mut trip);
+        let free: Vec<Triplet<usize, usize, f64>> = trip
+            .iter()
+            .filter_map(|e| match (self.index[e.row], self.index[e.col]) {
+                (Some(i), Some(j)) => Some(Triplet::new(i, j, e.val)),
+                _ => None,
+            })
+            .collect();
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
+            .map_err(|e| StaticsError::Singular(format!("{e:?}")))?;
+        a.sp_lu().map_err(|e| StaticsError::Singular(format!("{e:?}")))
+    }
+
+    fn gather(&self, v: &[f64]) -> Mat<f64> {
+        let mut m = Mat::zeros(self.n_free, 1);
+        for (d, i) in self.index.iter().enumerate() {
+            if let Some(i) = i {
+                m[(*i, 0)] = v[d];
+            }
+        }
+        m
+    }
+
+    fn scatter(&self, m: &Mat<f64>, out: &mut [f64]) {
+        for (d, i) in self.index.iter().enumerate() {
+            if let Some(i) = i {
+                out[d] = m[(*i, 0)];
+            }
+        }
+    }
+}
+
+/// Residual `f_ext - f_int` at `t` (returned: its max norm on the free dofs) and the
+/// reference magnitude `max(|f_ext|∞, |f_int|∞)` over all dofs (reactions included).
+fn residual(model: &mut dyn Model, t: f64, fd: &FreeDofs, r: &mut [f64]) -> (f64, f64) {
+    let n = r.len();
+    let mut fi = vec![0.0; n];
+    model.internal_force(&mut fi);
+    model.external_force(t, r);
+    let (mut rn, mut en, mut inn) = (0.0f64, 0.0f64, 0.0f64);
+    for d in 0..n {
+        en = en.max(r[d].abs());
+        inn = inn.max(fi[d].abs());
+        r[d] -= fi[d];
+        if fd.index[d].is_some() {
+            rn = rn.max(r[d].abs());
+        }
+    }
+    (rn, en.max(inn).max(1e-300))
+}
+
+/// Load-stepped Newton: advances from the model's committed state through the load factors
+/// `targets` (increasing), calling `on_step` after each converged target. Steps that fail are
+/// halved up to `max_cuts` times.
+pub fn load_steps(
+    model: &mut dyn Model,
+    targets: &[f64],
+    s: &NewtonSettings,
+    mut on_step: impl FnMut(&dyn Model, Converged),
+) -> Result<Vec<Converged>, StaticsError> {
+    let fd = FreeDofs::new(model);
+    let n = model.n_dof();
+    let mut applied = vec![0.0; n];
+    let mut t_now = 0.0;
+    let mut out = Vec::new();
+    for &target in targets {
+        let mut h = target - t_now;
+        let mut cuts = 0;
+        while t_now < target - 1e-14 * target.abs().max(1.0) {
+            let t = (t_now + h).min(target);
+            match newton(model, t, &fd, &mut applied, s) {
+                Ok(c) => {
+                    model.commit();
+                    t_now = t;
+                    if t >= target - 1e-14 * target.abs().max(1.0) {
+                        out.push(c);
+                        on_step(&*model, c);
+                    }
+                }
+                Err(res) => {
+                    model.revert();
+                    cuts += 1;
+                    if cuts > s.max_cuts {
+                        return Err(StaticsError::NoConvergence { from: t_now, to: target, cuts, residual: res });
+                    }
+                    h *= 0.5;
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Newton iterations at load factor `t`; `applied` tracks the constrained dofs' totals
+/// (restored on failure). Returns the relative residual on failure.
+fn newton(model: &mut dyn Model, t: f64, fd: &FreeDofs, applied: &mut [f64], s: &NewtonSettings) -> Result<Converged, f64> {
+    let n = applied.len();
+    let saved = applied.to_vec();
+    let mut presc = applied.to_vec();
+    model.prescribed(t, &mut presc);
+    let mut du = vec![0.0; n];
+    let cons = model.constrained().to_vec();
+    for d in 0..n {
+        if cons[d] {
+            du[d] = presc[d] - applied[d];
+            applied[d] = presc[d];
+        }
+    }
+    model.apply_increment(&du);
+    let mut r = vec![0.0; n];
+    let mut last = f64::INFINITY;
+    for it in 0..=s.max_iter {
+        let (rn, scale) = residual(model, t, fd, &mut r);
+        last = rn / scale;
+        if !last.is_finite() {
+            break;
+        }
+        if last <= s.tol {
+            return Ok(Converged { t, iterations: it, residual: last });
+        }
+        if it == s.max_iter {
+            break;
+        }
+        let lu = match fd.factor(model, t) {
+            Ok(lu) => lu,
+            Err(_) => break,
+        };
+        let mut rhs = fd.gather(&r);
+        lu.solve_in_place(rhs.as_mut());
+        du.fill(0.0);
+        fd.scatter(&rhs, &mut du);
+        if du.iter().any(|v| !v.is_finite()) {
+            break;
+        }
+        model.apply_increment(&du);
+    }
+    applied.copy_from_slice(&saved);
+    Err(last)
+}
+
+/// Displacement control: the loads scale with the load factor `λ` (external force linear in
+/// `t`, `f_ext(λ) = λ f_ext(1)` at the current configuration), and dof `control` is driven
+/// through the values `targets`; returns the converged `λ` at each. Prescribed dofs must be
+/// fixed (zero).
+pub fn displacement_control(
+    model: &mut dyn Model,
+    control: usize,
+    targets: &[f64],
+    s: &NewtonSettings,
+    mut on_step: impl FnMut(&dyn Model, Converged),
+) -> Result<Vec<Converged>, StaticsError> {
+    let fd = FreeDofs::new(model);
+    let n = model.n_dof();
+    let Some(c) = fd.index.get(control).copied().flatten() else {
+        return Err(StaticsError::BadControl(control));
+    };
+    let mut lambda = 0.0;
+    let mut uc = 0.0;
+    let mut out = Vec::new();
+    let mut r = vec![0.0; n];
+    let mut fref = vec![0.0; n];
+    let mut du = vec![0.0; n];
+    for &target in targets {
+        let mut ok = false;
+        let mut last = f64::INFINITY;
+        for it in 0..=s.max_iter {
+            let (rn, scale) = residual(model, lambda, &fd, &mut r);
+            last = rn / scale;
+            if last <= s.tol && (uc - target).abs() <= 1e-12 * target.abs().max(1e-30) {
+                let conv = Converged { t: lambda, iterations: it, residual: last };
+                model.commit();
+                out.push(conv);
+                on_step(&*model, conv);
+                ok = true;
+                break;
+            }
+            if it == s.max_iter || !last.is_finite() {
+                break;
+            }
+            model.external_force(1.0, &mut fref);
+            let lu = fd.factor(model, lambda)?;
+            let mut a = fd.gather(&r);
+            lu.solve_in_place(a.as_mut());
+            let mut b = fd.gather(&fref);
+            lu.solve_in_place(b.as_mut());
+            let dl = (target - uc - a[(c, 0)]) / b[(c, 0)];
+            let step = Mat::from_fn(fd.n_free, 1, |i, _| a[(i, 0)] + dl * b[(i, 0)]);
+            du.fill(0.0);
+            fd.scatter(&step, &mut du);
+            model.apply_increment(&du);
+            lambda += dl;
+            uc += du[control];
+        }
+        if !ok {
+            return Err(StaticsError::NoConvergence { from: uc, to: target, cuts: 0, residual: last });
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,61 @@
+//! Time integration of a [`Model`](crate::model::Model) (DESIGN §6): explicit central
+//! differences with a critical step estimated from the model, and implicit Newmark (average
+//! acceleration) and implicit midpoint with Newton and a sparse direct solve.
+//!
+//! The integrators own velocities and accelerations per dof; the model owns the configuration
+//! (rotations composed, material and hourglass state), so a checkpoint of a run is the model's
+//! state plus [`Dynamics`].
+//!
+//! Loads received over the coupling interface enter every step as an extra nodal force vector
+//! (`extra`), added to the model's own external forces.
+
+pub mod critical;
+pub mod explicit;
+pub mod implicit;
+
+pub use critical::{critical_dt, CriticalDt};
+pub use explicit::CentralDifference;
+pub use implicit::{Implicit, ImplicitError, ImplicitScheme, NewtonParams, StepInfo};
+
+use crate::model::Model;
+
+/// Time, velocity and acceleration per dof: the integrator's part of a checkpoint.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Dynamics {
+    pub t: f64,
+    pub v: Vec<f64>,
+    pub a: Vec<f64>,
+}
+
+/// Prescribed increments of the constrained dofs over `[t, t + dt]` written into `du`.
+fn prescribed_increment(model: &dyn Model, t: f64, dt: f64, scratch: &mut [f64], du: &mut [f64]) {
+    scratch.fill(0.0);
+    model.prescribed(t, scratch);
+    du.fill(0.0);
+    model.prescribed(t + dt, du);
+    for ((d, s), &c) in du.iter_mut().zip(scratch.iter()).zip(model.constrained()) {
+        *d = if c { *d - s } else { 0.0 };
+    }
+}
+
+/// `f_ext(t) + extra - f_int` at the model's current configuration, written into `r`;
+/// `f_int` is left in `fi`.
+fn out_of_balance(model: &mut dyn Model, t: f64, extra: Option<&[f64]>, fi: &mut [f64], r: &mut [f64]) {
+    fi.fill(0.0);
+    model.internal_force(fi);
+    r.fill(0.0);
+    model.external_force(t, r);
+    if let Some(x) = extra {
+        for (r, x) in r.iter_mut().zip(x) {
+            *r += x;
+        }
+    }
+    for (r, f) in r.iter_mut().zip(fi.iter()) {
+        *r -= f;
+    }
+}
+
+/// Kinetic energy `½ vᵀ M v` with the lumped mass.
+pub fn kinetic_energy(model: &dyn Model, v: &[f64]) -> f64 {
+    0.5 * model.lumped_mass().iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>()
+}
