@@ -26,9 +26,12 @@ impl InitialCondition {
 
     /// The conserved state of every node; an error names the first state outside the EOS.
     pub fn state(&self, mesh: &Mesh, eos: &Eos) -> Result<State, String> {
-        for (k, w) in std::iter::once(&self.background).chain(self.regions.iter().map(|r| &r.1)).enumerate() {
+        for (k, w) in
+            std::iter::once(&self.background).chain(self.regions.iter().map(|r| &r.1)).enumerate()
+        {
             eos.check(w).map_err(|e| {
-                let which = if k == 0 { "state".to_string() } else { format!("regions[{}].state", k - 1) };
+                let which =
+                    if k == 0 { "state".to_string() } else { format!("regions[{}].state", k - 1) };
                 format!("fluid.initial.{which} = {w:?} is not a valid state of the EOS: {e}")
             })?;
         }

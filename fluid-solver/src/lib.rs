@@ -10,12 +10,17 @@
 #![deny(unsafe_op_in_unsafe_fn)]
 
 pub mod bc;
+pub mod bench;
 pub mod eos;
 pub mod flux;
 pub mod initial;
 pub mod mesh;
+pub mod output;
+pub mod probes;
 pub mod reconstruct;
 pub mod riemann;
 pub mod semidiscretization;
+pub mod setup;
+pub mod solver;
 pub mod state;
 pub mod time;

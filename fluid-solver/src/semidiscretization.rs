@@ -86,7 +86,10 @@ impl Semidiscretization {
         let mut patches = Vec::new();
         for (name, bc) in conditions {
             let index = mesh.boundaries.iter().position(|b| &b.name == name).ok_or_else(|| {
-                MeshError::UnknownBoundary { name: name.clone(), known: mesh.boundary_names().join(", ") }
+                MeshError::UnknownBoundary {
+                    name: name.clone(),
+                    known: mesh.boundary_names().join(", "),
+                }
             })?;
             patches.push((index, *bc));
         }
@@ -187,19 +190,24 @@ impl Semidiscretization {
     }
 
     /// Adds the boundary fluxes, patch by patch (sequential: a fixed order, few nodes).
-    fn add_boundary_fluxes(&self, prim: &[[f64; 5]], residual: &mut [[f64; 5]]) -> Result<(), FluidError> {
+    fn add_boundary_fluxes(
+        &self,
+        prim: &[[f64; 5]],
+        residual: &mut [[f64; 5]],
+    ) -> Result<(), FluidError> {
         for &(b, bc) in &self.patches {
             let boundary = &self.mesh.boundaries[b];
             for (&node, n) in boundary.nodes.iter().zip(&boundary.normals) {
                 let node = node as usize;
-                let f = bc.flux(self.numerics.flux, &self.eos, &prim[node], n).map_err(|error| {
-                    FluidError::Boundary {
-                        boundary: boundary.name.clone(),
-                        node,
-                        position: self.mesh.coords[node],
-                        error,
-                    }
-                })?;
+                let f =
+                    bc.flux(self.numerics.flux, &self.eos, &prim[node], n).map_err(|error| {
+                        FluidError::Boundary {
+                            boundary: boundary.name.clone(),
+                            node,
+                            position: self.mesh.coords[node],
+                            error,
+                        }
+                    })?;
                 for k in 0..5 {
                     residual[node][k] += f[k];
                 }

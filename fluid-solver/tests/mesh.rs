@@ -7,7 +7,13 @@ use fluid_solver::mesh::{perturb, Cell, CellKind, Mesh, MeshError, RawMesh, Tagg
 use fluid_solver::reconstruct::gradient::LsqGradient;
 
 fn graded(shape: BoxCells) -> BoxSpec {
-    BoxSpec { lo: [-1.0, 0.0, 2.0], hi: [1.0, 0.5, 3.0], cells: [7, 4, 5], grading: [1.2, 0.8, 1.0], shape }
+    BoxSpec {
+        lo: [-1.0, 0.0, 2.0],
+        hi: [1.0, 0.5, 3.0],
+        cells: [7, 4, 5],
+        grading: [1.2, 0.8, 1.0],
+        shape,
+    }
 }
 
 /// Asserts the closure and volume invariants; returns the mesh.
@@ -78,7 +84,10 @@ fn prisms_and_pyramids_are_closed() {
     // Prisms: triangles (0,1,2),(0,2,3) extruded.
     let prisms = RawMesh {
         coords: cube.clone(),
-        cells: vec![Cell::new(CellKind::Prism, &[0, 1, 2, 4, 5, 6]), Cell::new(CellKind::Prism, &[0, 2, 3, 4, 6, 7])],
+        cells: vec![
+            Cell::new(CellKind::Prism, &[0, 1, 2, 4, 5, 6]),
+            Cell::new(CellKind::Prism, &[0, 2, 3, 4, 6, 7]),
+        ],
         faces: vec![
             TaggedFace { patch: 0, nodes: vec![0, 1, 2] },
             TaggedFace { patch: 0, nodes: vec![0, 2, 3] },
@@ -112,7 +121,13 @@ fn prisms_and_pyramids_are_closed() {
 
 #[test]
 fn least_squares_gradients_are_exact_on_linear_fields() {
-    let g = [[1.0, -2.0, 0.5], [0.0, 3.0, 1.0], [2.0, 0.0, -1.0], [-0.5, 0.25, 4.0], [10.0, 20.0, 30.0]];
+    let g = [
+        [1.0, -2.0, 0.5],
+        [0.0, 3.0, 1.0],
+        [2.0, 0.0, -1.0],
+        [-0.5, 0.25, 4.0],
+        [10.0, 20.0, 30.0],
+    ];
     let c = [1.0, 2.0, -3.0, 0.5, 100.0];
     for shape in [BoxCells::Hex, BoxCells::Tet] {
         let mut raw = graded(shape).raw().unwrap();
@@ -122,14 +137,20 @@ fn least_squares_gradients_are_exact_on_linear_fields() {
         let values: Vec<[f64; 5]> = mesh
             .coords
             .iter()
-            .map(|x| std::array::from_fn(|k| c[k] + g[k][0] * x[0] + g[k][1] * x[1] + g[k][2] * x[2]))
+            .map(|x| {
+                std::array::from_fn(|k| c[k] + g[k][0] * x[0] + g[k][1] * x[1] + g[k][2] * x[2])
+            })
             .collect();
         let mut grad = vec![[[0.0; 3]; 5]; mesh.n_nodes()];
         lsq.compute(&mesh, &values, &mut grad);
         for gi in &grad {
             for k in 0..5 {
                 for d in 0..3 {
-                    assert!((gi[k][d] - g[k][d]).abs() < 1e-10 * 30.0, "{shape:?} {k} {d}: {}", gi[k][d]);
+                    assert!(
+                        (gi[k][d] - g[k][d]).abs() < 1e-10 * 30.0,
+                        "{shape:?} {k} {d}: {}",
+                        gi[k][d]
+                    );
                 }
             }
         }
@@ -175,7 +196,12 @@ fn bad_meshes_give_named_errors() {
     let e = Mesh::build(raw).unwrap_err();
     assert!(matches!(e, MeshError::OrphanFace { .. }), "{e}");
 
-    let mesh = Mesh::build(BoxSpec::uniform([0.0; 3], [1.0; 3], [1, 1, 1], BoxCells::Hex).raw().unwrap()).unwrap();
+    let mesh =
+        Mesh::build(BoxSpec::uniform([0.0; 3], [1.0; 3], [1, 1, 1], BoxCells::Hex).raw().unwrap())
+            .unwrap();
     let e = mesh.boundary("inlet").unwrap_err();
-    assert!(e.to_string().contains("unknown boundary `inlet`") && e.to_string().contains("xmin"), "{e}");
+    assert!(
+        e.to_string().contains("unknown boundary `inlet`") && e.to_string().contains("xmin"),
+        "{e}"
+    );
 }

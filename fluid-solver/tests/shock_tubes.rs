@@ -17,9 +17,9 @@ use fluid_solver::semidiscretization::Numerics;
 use serde_json::json;
 
 const CELLS: [usize; 3] = [100, 200, 400];
-/// The time step counts the lateral and symmetry facets of the one-cell-thick tube, which carry
-/// no waves: CFL 2 here is a 1D Courant number of about 0.4-0.5 (hexes; less on tets).
-const CFL: f64 = 2.0;
+/// The time step counts the lateral and symmetry facets of the tube, which carry no waves: CFL
+/// 0.9 here is a 1D Courant number of about 0.4-0.6 on hexes (less on tets).
+const CFL: f64 = 0.9;
 
 struct Tube {
     name: &'static str,
@@ -36,15 +36,40 @@ struct Tube {
 fn toro() -> Vec<Tube> {
     let gas = Eos::PerfectGas { gamma: 1.4 };
     let w = |rho: f64, u: f64, p: f64| [rho, u, 0.0, 0.0, p];
-    let t = |name, left, right, x0, t, flux, star_abs| Tube { name, eos: gas, left, right, x0, t, flux, star_abs };
+    let t = |name, left, right, x0, t, flux, star_abs| Tube {
+        name,
+        eos: gas,
+        left,
+        right,
+        x0,
+        t,
+        flux,
+        star_abs,
+    };
     vec![
         t("toro1", w(1.0, 0.0, 1.0), w(0.125, 0.0, 0.1), 0.3, 0.2, FluxScheme::Roe, None),
         // Near vacuum: p* = 0.00189, ρ* = 0.0219; absolute tolerances on (ρ, u, p), the velocity
         // to 2.5% of the velocity jump 4 (the star velocity there is the worst-resolved quantity).
-        t("toro2", w(1.0, -2.0, 0.4), w(1.0, 2.0, 0.4), 0.5, 0.15, FluxScheme::Hllc, Some([0.01, 0.1, 0.003])),
+        t(
+            "toro2",
+            w(1.0, -2.0, 0.4),
+            w(1.0, 2.0, 0.4),
+            0.5,
+            0.15,
+            FluxScheme::Hllc,
+            Some([0.01, 0.1, 0.003]),
+        ),
         t("toro3", w(1.0, 0.0, 1000.0), w(1.0, 0.0, 0.01), 0.5, 0.012, FluxScheme::Roe, None),
         t("toro4", w(1.0, 0.0, 0.01), w(1.0, 0.0, 100.0), 0.4, 0.035, FluxScheme::Roe, None),
-        t("toro5", w(5.99924, 19.5975, 460.894), w(5.99242, -6.19633, 46.0950), 0.4, 0.035, FluxScheme::Roe, None),
+        t(
+            "toro5",
+            w(5.99924, 19.5975, 460.894),
+            w(5.99242, -6.19633, 46.0950),
+            0.4,
+            0.035,
+            FluxScheme::Roe,
+            None,
+        ),
     ]
 }
 
@@ -54,7 +79,16 @@ fn liquids() -> Vec<Tube> {
     let tait = Eos::tait(2.07e9, 7.15, 1000.0, 1e5);
     vec![
         // Water-water shock tube of Saurel & Abgrall (J. Comput. Phys. 150, 1999, §6.1).
-        Tube { name: "stiffened_gas_water", eos: sg, left: w(1000.0, 1e9), right: w(1000.0, 1e5), x0: 0.7, t: 2.2e-4, flux: FluxScheme::Roe, star_abs: None },
+        Tube {
+            name: "stiffened_gas_water",
+            eos: sg,
+            left: w(1000.0, 1e9),
+            right: w(1000.0, 1e5),
+            x0: 0.7,
+            t: 2.2e-4,
+            flux: FluxScheme::Roe,
+            star_abs: None,
+        },
         Tube {
             name: "tait_water",
             eos: tait,
@@ -75,29 +109,37 @@ fn run(tube: &Tube, shape: BoxCells) -> serde_json::Value {
     let mut errors = Vec::new();
     let mut star_report = json!(null);
     for &n in &CELLS {
-        let (semi, mut state) = shock_tube(n, shape, tube.eos, tube.left, tube.right, tube.x0, numerics);
+        let (semi, mut state) =
+            shock_tube(n, shape, tube.eos, tube.left, tube.right, tube.x0, numerics);
         march(&semi, &mut state, tube.t, CFL);
         let rho: Vec<f64> = state.cons.iter().map(|q| q[0]).collect();
         errors.push(l1_error(&semi.mesh, &rho, |x| exact.at(x[0])[0]));
         if n == *CELLS.last().unwrap() {
             let prim = primitives(&tube.eos, &state);
             let (xl, xr) = exact.plateau_middles();
+            let (wl, wr) = exact.plateau_widths();
             let star = exact.solution.star;
             let mut checks = Vec::new();
-            for (what, x, k, value) in [
-                ("rho_l", xl, 0, star.rho_l),
-                ("rho_r", xr, 0, star.rho_r),
-                ("u", xl, 1, star.u),
-                ("u", xr, 1, star.u),
-                ("p", xl, 4, star.p),
-                ("p", xr, 4, star.p),
+            for (what, x, width, k, value) in [
+                ("rho_l", xl, wl, 0, star.rho_l),
+                ("rho_r", xr, wr, 0, star.rho_r),
+                ("u", xl, wl, 1, star.u),
+                ("u", xr, wr, 1, star.u),
+                ("p", xl, wl, 4, star.p),
+                ("p", xr, wr, 4, star.p),
             ] {
                 let got = tube_value(&semi.mesh, &prim, k, x);
+                // A plateau narrower than 20 cells keeps its middle within the smeared contact
+                // and shock profiles: 3% there (Toro 3 right, Toro 4 left), 1% elsewhere.
+                let rel = if width * (n as f64) < 20.0 { 0.03 } else { 0.01 };
                 let tol = match tube.star_abs {
                     Some(abs) => abs[[0, 1, 0, 0, 2][k]],
-                    None => 0.01 * value.abs().max(1e-3 * exact_scale(k, tube)),
+                    None => rel * value.abs().max(1e-3 * exact_scale(k, tube)),
                 };
-                checks.push(json!({"what": what, "x": x, "exact": value, "computed": got}));
+                checks.push(json!({
+                    "what": what, "x": x, "plateau_cells": width * n as f64,
+                    "exact": value, "computed": got, "tolerance": tol
+                }));
                 assert!(
                     (got - value).abs() <= tol,
                     "{} {shape:?}: star {what} at x = {x:.4}: computed {got}, exact {value} (tolerance {tol:e})",
@@ -110,7 +152,11 @@ fn run(tube: &Tube, shape: BoxCells) -> serde_json::Value {
     let order = orders(&errors);
     let overall = (errors[0] / errors[2]).log2() / 2.0;
     println!("{} {shape:?}: L1(ρ) {errors:?}, orders {order:?}, overall {overall:.3}", tube.name);
-    assert!(overall >= 0.6, "{} {shape:?}: observed order {overall} < 0.6 (errors {errors:?})", tube.name);
+    assert!(
+        overall >= 0.6,
+        "{} {shape:?}: observed order {overall} < 0.6 (errors {errors:?})",
+        tube.name
+    );
     assert!(order.iter().all(|&o| o > 0.3), "{} {shape:?}: orders {order:?}", tube.name);
     json!({"cells": CELLS, "l1_density": errors, "orders": order, "star_finest": star_report})
 }

@@ -25,7 +25,14 @@ pub fn drift(u: &[f64], v: &[f64], h: f64, out: &mut [f64]) {
 }
 
 /// C0 start: the state predicted for t^{1/2}, u^0 + Δt/2 v^0 + Δt²/8 a^0 and v^0 + Δt/2 a^0.
-pub fn c0_start_prediction(u: &[f64], v: &[f64], a: &[f64], dt: f64, up: &mut [f64], vp: &mut [f64]) {
+pub fn c0_start_prediction(
+    u: &[f64],
+    v: &[f64],
+    a: &[f64],
+    dt: f64,
+    up: &mut [f64],
+    vp: &mut [f64],
+) {
     for i in 0..u.len() {
         up[i] = u[i] + 0.5 * dt * v[i] + dt * dt / 8.0 * a[i];
         vp[i] = v[i] + 0.5 * dt * a[i];
@@ -43,7 +50,8 @@ pub fn c0_prediction(
     vp: &mut [f64],
 ) {
     for i in 0..u_next.len() {
-        up[i] = u_next[i] + dt * (C0_ALPHA0 + C0_ALPHA1) * v_half[i] - dt * C0_ALPHA1 * v_half_prev[i];
+        up[i] =
+            u_next[i] + dt * (C0_ALPHA0 + C0_ALPHA1) * v_half[i] - dt * C0_ALPHA1 * v_half_prev[i];
         vp[i] = 2.0 * v_half[i] - v_half_prev[i];
     }
 }
@@ -98,7 +106,8 @@ impl Dynamics for Diagonal {
         for i in 0..u.len() {
             let (m, k, c) = (self.m[i], self.k[i], self.c[i]);
             // With s = v^n + v^{n+1}: s (m + Δt² k/4 + Δt c/2) = 2 m v^n + Δt (f - k u^n).
-            let s = (2.0 * m * v[i] + dt * (f[i] - k * u[i])) / (m + dt * dt * k / 4.0 + dt * c / 2.0);
+            let s =
+                (2.0 * m * v[i] + dt * (f[i] - k * u[i])) / (m + dt * dt * k / 4.0 + dt * c / 2.0);
             u[i] += 0.5 * dt * s;
             v[i] = s - v[i];
         }
@@ -179,9 +188,18 @@ impl Staggered {
                 }
                 kick(&self.v, &self.a, 0.5 * dt, &mut self.v_half);
                 drift(&self.u, &self.v_half, dt, &mut self.u_next);
-                c0_prediction(&self.u_next, &self.v_half, &self.v_half_prev, dt, &mut self.up, &mut self.vp);
+                c0_prediction(
+                    &self.u_next,
+                    &self.v_half,
+                    &self.v_half_prev,
+                    dt,
+                    &mut self.up,
+                    &mut self.vp,
+                );
             }
-            Scheme::A6 => a6_prediction(&self.u, &self.v, &self.a_hat, dt, &mut self.up, &mut self.vp),
+            Scheme::A6 => {
+                a6_prediction(&self.u, &self.v, &self.a_hat, dt, &mut self.up, &mut self.vp)
+            }
         }
     }
 
@@ -262,7 +280,8 @@ mod tests {
     }
 
     fn observed_order(scheme: Scheme) -> f64 {
-        let e: Vec<f64> = [100, 200, 400].iter().map(|&n| (run(scheme, n) - exact(T)).abs()).collect();
+        let e: Vec<f64> =
+            [100, 200, 400].iter().map(|&n| (run(scheme, n) - exact(T)).abs()).collect();
         let orders = [(e[0] / e[1]).log2(), (e[1] / e[2]).log2()];
         assert!((orders[0] - orders[1]).abs() < 0.2, "{scheme:?}: errors {e:?}, orders {orders:?}");
         orders[1]

@@ -36,14 +36,19 @@ impl HelloInfo {
 
 /// Checks the two `Hello`s against each other and against the launcher's case hash; the error
 /// names every disagreeing value of both sides.
-pub fn check(fluid: &Hello, structure: &Hello, expected_case_hash: u64) -> Result<(), ProtocolError> {
+pub fn check(
+    fluid: &Hello,
+    structure: &Hello,
+    expected_case_hash: u64,
+) -> Result<(), ProtocolError> {
     let mut problems = Vec::new();
     for (hello, role) in [(fluid, Role::Fluid), (structure, Role::Structure)] {
         if hello.role != role.code() {
             problems.push(format!("the {} hello carries role code {}", role.name(), hello.role));
         }
     }
-    if fluid.protocol_version != PROTOCOL_VERSION || structure.protocol_version != PROTOCOL_VERSION {
+    if fluid.protocol_version != PROTOCOL_VERSION || structure.protocol_version != PROTOCOL_VERSION
+    {
         problems.push(format!(
             "protocol version: fluid {} (pid {}), structure {} (pid {}), launcher {PROTOCOL_VERSION}",
             fluid.protocol_version, fluid.pid, structure.protocol_version, structure.pid
@@ -87,7 +92,14 @@ impl Command {
 
     /// `Advance` from `t_from` to `t_to` in coupling step `step`, `phase` one of `scheme_phase`.
     pub fn advance(step: u64, t_from: f64, t_to: f64, phase: u32) -> Command {
-        Command { kind: command_kind::ADVANCE, scheme_phase: phase, step, t_from, t_to, ..Command::default() }
+        Command {
+            kind: command_kind::ADVANCE,
+            scheme_phase: phase,
+            step,
+            t_from,
+            t_to,
+            ..Command::default()
+        }
     }
 
     /// `Checkpoint` named `tag`.

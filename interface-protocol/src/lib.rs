@@ -8,6 +8,7 @@
 //! rigid-body solver.
 #![deny(unsafe_op_in_unsafe_fn)]
 
+pub mod bench;
 pub mod case;
 pub mod coupling;
 pub mod endpoint;

@@ -77,7 +77,8 @@ impl Watch {
     /// launcher is the parent, arms `PR_SET_PDEATHSIG` with SIGTERM.
     pub fn from_env() -> Watch {
         install_signal_handlers();
-        let launcher = std::env::var(LAUNCHER_PID_ENV).ok().and_then(|s| s.trim().parse::<i32>().ok());
+        let launcher =
+            std::env::var(LAUNCHER_PID_ENV).ok().and_then(|s| s.trim().parse::<i32>().ok());
         // SAFETY: `getppid` has no preconditions.
         let parent = unsafe { libc::getppid() };
         let launcher_is_parent = launcher == Some(parent);
@@ -110,5 +111,121 @@ impl Watch {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Real processes: the test binary re-runs itself as a participant (and as a launcher that
+    //! dies), selected by `FSI_TEST_ROLE`.
+    use crate::endpoint::{ControlPort, LauncherLink, StructureEndpoint, Timeouts};
+    use crate::handshake::HelloInfo;
+    use crate::messages::Role;
+    use crate::shm;
+    use std::path::{Path, PathBuf};
+    use std::process::{Child, Command};
+    use std::time::{Duration, Instant};
+
+    const ENTRY: &str = "liveness::tests::process_entry";
+
+    fn reexec(role: &str, run_id: &str, out: &Path) -> Command {
+        let mut c = Command::new(std::env::current_exe().unwrap());
+        c.args(["--exact", ENTRY, "--ignored", "--nocapture", "--test-threads=1"])
+            .env("FSI_TEST_ROLE", role)
+            .env("FSI_TEST_RUN", run_id)
+            .env("FSI_TEST_OUT", out)
+            .env_remove(super::LAUNCHER_PID_ENV)
+            .stdout(std::process::Stdio::null());
+        c
+    }
+
+    /// Entry point of the child processes (ignored in a normal test run).
+    #[test]
+    #[ignore = "entry point of the processes started by the liveness tests"]
+    fn process_entry() {
+        let (Ok(role), Ok(run_id), Ok(out)) = (
+            std::env::var("FSI_TEST_ROLE"),
+            std::env::var("FSI_TEST_RUN"),
+            std::env::var("FSI_TEST_OUT"),
+        ) else {
+            return;
+        };
+        match role.as_str() {
+            "participant" => {
+                let timeouts = Timeouts { wait: Duration::from_secs(30), ..Timeouts::default() };
+                let mut s =
+                    StructureEndpoint::open(&run_id, HelloInfo::default(), timeouts).unwrap();
+                let e = s.control().next_command().unwrap_err();
+                drop(s);
+                std::fs::write(&out, e.to_string()).unwrap();
+                std::process::exit(3);
+            }
+            "launcher" => {
+                let mut c = reexec("participant", &run_id, Path::new(&out));
+                c.env(super::LAUNCHER_PID_ENV, std::process::id().to_string());
+                let _child = c.spawn().unwrap();
+                std::thread::sleep(Duration::from_secs(60));
+            }
+            _ => {}
+        }
+    }
+
+    fn setup(test: &str) -> (String, PathBuf, LauncherLink) {
+        let run_id = format!("t{}-{test}", std::process::id());
+        let out = std::env::temp_dir().join(format!("fsi-{run_id}.txt"));
+        let _ = std::fs::remove_file(&out);
+        let link = LauncherLink::open(&run_id, Timeouts::default()).unwrap();
+        (run_id, out, link)
+    }
+
+    /// Waits until the child wrote its error; returns it and the time it took.
+    fn outcome(out: &Path, since: Instant) -> (String, Duration) {
+        while since.elapsed() < Duration::from_secs(5) {
+            if let Ok(text) = std::fs::read_to_string(out) {
+                if !text.is_empty() {
+                    return (text, since.elapsed());
+                }
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        panic!("the participant did not stop within 5 s");
+    }
+
+    fn kill(child: &Child, signal: i32) {
+        // SAFETY: sends a signal to our own child process.
+        unsafe { libc::kill(child.id() as i32, signal) };
+    }
+
+    #[test]
+    fn sigterm_ends_a_waiting_participant_cleanly() {
+        let (run_id, out, mut link) = setup("sigterm");
+        let mut child = reexec("participant", &run_id, &out).spawn().unwrap();
+        link.wait_hello(Role::Structure, Instant::now() + Duration::from_secs(20)).unwrap();
+        let start = Instant::now();
+        kill(&child, libc::SIGTERM);
+        let status = child.wait().unwrap();
+        let (text, took) = outcome(&out, start);
+        assert_eq!(status.code(), Some(3));
+        assert_eq!(text, "stopped by SIGTERM");
+        assert!(took < Duration::from_secs(1), "took {took:?}");
+        link.remove_resources().unwrap();
+        assert!(shm::run_files(&run_id).is_empty());
+        let _ = std::fs::remove_file(&out);
+    }
+
+    #[test]
+    fn a_participant_leaves_within_a_second_when_its_launcher_dies() {
+        let (run_id, out, mut link) = setup("orphan");
+        let mut launcher = reexec("launcher", &run_id, &out).spawn().unwrap();
+        link.wait_hello(Role::Structure, Instant::now() + Duration::from_secs(20)).unwrap();
+        let start = Instant::now();
+        kill(&launcher, libc::SIGKILL);
+        launcher.wait().unwrap();
+        let (text, took) = outcome(&out, start);
+        assert!(text == "stopped by SIGTERM" || text.contains("launcher"), "{text}");
+        assert!(took < Duration::from_secs(1), "took {took:?}");
+        link.remove_resources().unwrap();
+        assert!(shm::run_files(&run_id).is_empty());
+        let _ = std::fs::remove_file(&out);
     }
 }

@@ -46,7 +46,8 @@ impl Failure {
 
 impl From<ProtocolError> for Failure {
     fn from(e: ProtocolError) -> Failure {
-        let fatal = matches!(e, ProtocolError::Terminated { .. } | ProtocolError::LauncherGone { .. });
+        let fatal =
+            matches!(e, ProtocolError::Terminated { .. } | ProtocolError::LauncherGone { .. });
         Failure { code: failure_code::PROTOCOL, message: e.to_string(), fatal: fatal.then_some(e) }
     }
 }
@@ -66,7 +67,10 @@ pub trait Handler<E> {
 
 /// Answers commands until `Finish` (then `Ok`), or until a wait fails, a signal arrives or the
 /// launcher dies (then `Err`; the caller drops the endpoint, reports on stderr and exits non-zero).
-pub fn serve<E: ControlPort, H: Handler<E>>(endpoint: &mut E, handler: &mut H) -> Result<(), ProtocolError> {
+pub fn serve<E: ControlPort, H: Handler<E>>(
+    endpoint: &mut E,
+    handler: &mut H,
+) -> Result<(), ProtocolError> {
     let mut last = Progress { step: 0, t: 0.0, dt_stable: f64::INFINITY };
     loop {
         let command = endpoint.control().next_command()?;

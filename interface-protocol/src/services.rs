@@ -89,7 +89,9 @@ pub fn node(run_id: &str, name: &str) -> Result<Node<ipc::Service>, ProtocolErro
         .config(&config)
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
-        .map_err(|e| ProtocolError::Ipc(format!("cannot create the node `{name}` of run {run_id}: {e:?}")))
+        .map_err(|e| {
+            ProtocolError::Ipc(format!("cannot create the node `{name}` of run {run_id}: {e:?}"))
+        })
 }
 
 #[cfg(test)]

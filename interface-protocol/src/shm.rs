@@ -72,7 +72,11 @@ pub fn cleanup_run(run_id: &str) -> Result<usize, ProtocolError> {
     services::validate_run_id(run_id)?;
     let mut removed = 0;
     for path in run_files(run_id) {
-        let r = if path.is_dir() { std::fs::remove_dir_all(&path) } else { std::fs::remove_file(&path) };
+        let r = if path.is_dir() {
+            std::fs::remove_dir_all(&path)
+        } else {
+            std::fs::remove_file(&path)
+        };
         match r {
             Ok(()) => removed += 1,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}

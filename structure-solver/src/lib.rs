@@ -9,6 +9,7 @@
 
 pub mod assembly;
 pub mod elements;
+pub mod explicit_shell;
 pub mod material;
 pub mod mesh;
 pub mod modal;

@@ -71,8 +71,10 @@ impl FreeDofs {
         FreeDofs { index, n_free }
     }
 
-    /// LU of the free-free block of the tangent at `t`.
-    fn factor(&self, model: &mut dyn Model, t: f64) -> Result<faer::sparse::linalg::solvers::Lu<usize, f64>, StaticsError> {
+    /// Factors the free-free block of the tangent at `t` (LU: the corotational tangent is not
+    /// symmetric away from equilibrium, and its symmetric part slows Newton several-fold in
+    /// large rotations).
+    fn factor(&self, model: &mut dyn Model, t: f64) -> Result<Factor, StaticsError> {
         let mut trip = Vec::new();
         model.tangent(t, &mut trip);
         let free: Vec<Triplet<usize, usize, f64>> = trip
@@ -82,9 +84,9 @@ impl FreeDofs {
                 _ => None,
             })
             .collect();
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
-            .map_err(|e| StaticsError::Singular(format!("{e:?}")))?;
-        a.sp_lu().map_err(|e| StaticsError::Singular(format!("{e:?}")))
+        let err = |e: &dyn std::fmt::Debug| StaticsError::Singular(format!("{e:?}"));
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free).map_err(|e| err(&e))?;
+        a.sp_lu().map(Factor::Lu).map_err(|e| err(&e))
     }
 
     fn gather(&self, v: &[f64]) -> Mat<f64> {
@@ -102,6 +104,19 @@ impl FreeDofs {
             if let Some(i) = i {
                 out[d] = m[(*i, 0)];
             }
+        }
+    }
+}
+
+/// A factored tangent.
+enum Factor {
+    Lu(faer::sparse::linalg::solvers::Lu<usize, f64>),
+}
+
+impl Factor {
+    fn solve_in_place(&self, rhs: faer::MatMut<'_, f64>) {
+        match self {
+            Factor::Lu(f) => f.solve_in_place(rhs),
         }
     }
 }
@@ -126,8 +141,9 @@ fn residual(model: &mut dyn Model, t: f64, fd: &FreeDofs, r: &mut [f64]) -> (f64
 }
 
 /// Load-stepped Newton: advances from the model's committed state through the load factors
-/// `targets` (increasing), calling `on_step` after each converged target. Steps that fail are
-/// halved up to `max_cuts` times.
+/// `targets` (increasing), calling `on_step` after each converged target. Each step starts
+/// from the last converged state (a secant predictor built from summed spins made Newton
+/// slower in large rotations); a step that fails is halved, up to `max_cuts` times.
 pub fn load_steps(
     model: &mut dyn Model,
     targets: &[f64],
@@ -142,13 +158,14 @@ pub fn load_steps(
     for &target in targets {
         let mut h = target - t_now;
         let mut cuts = 0;
-        while t_now < target - 1e-14 * target.abs().max(1.0) {
+        let eps = 1e-14 * target.abs().max(1.0);
+        while t_now < target - eps {
             let t = (t_now + h).min(target);
             match newton(model, t, &fd, &mut applied, s) {
                 Ok(c) => {
                     model.commit();
                     t_now = t;
-                    if t >= target - 1e-14 * target.abs().max(1.0) {
+                    if t >= target - eps {
                         out.push(c);
                         on_step(&*model, c);
                     }

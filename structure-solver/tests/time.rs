@@ -227,7 +227,7 @@ fn central_difference_is_stable_below_the_estimated_critical_step_and_not_above(
     // ω_j = 2 sqrt(k/m) sin((2j-1)π / (2(2n+1))).
     let w_max = 20.0 * ((2 * n - 1) as f64 * std::f64::consts::PI / (2.0 * (2 * n + 1) as f64)).sin();
     let exact = 2.0 / w_max;
-    let est = critical_dt(&mut m, 0.0, 400);
+    let est = critical_dt(&mut m, 0.0, 400, 1e-6);
     println!("critical step: exact {exact:.6e}, power {:.6e}, Gershgorin {:.6e}, element {:.6e}", est.power, est.gershgorin, est.element);
     assert!(est.gershgorin <= exact && est.element <= exact);
     assert!((est.power - exact).abs() / exact < 0.01);

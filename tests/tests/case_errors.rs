@@ -66,7 +66,7 @@ fn a_wrong_type_names_the_field_and_line() {
 #[test]
 fn an_unknown_key_names_the_key_and_line() {
     let text = GOOD.replace("[structure.rigid]\n", "[structure.rigid]\nmas = 2.0\n");
-    rejects("unknown-key", &text, 18, &["structure.rigid.mas", "mass"]);
+    rejects("unknown-key", &text, 17, &["structure.rigid.mas", "mass"]);
 }
 
 #[test]

@@ -91,15 +91,15 @@ fn errors(scheme: &str, dts: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-fn check_order(scheme: &str, lo: f64, hi: f64) {
-    let dts = [1e-3, 5e-4, 2.5e-4];
+fn check_order(scheme: &str, dts: [f64; 3], lo: f64, hi: f64) {
     let e = errors(scheme, &dts);
     let p = observed_orders(&e);
-    println!("{scheme}: dt {dts:?} relative errors {e:.3e?} observed orders {p:.3?}");
+    let es: Vec<String> = e.iter().map(|x| format!("{x:.3e}")).collect();
+    println!("{scheme}: dt {dts:?} relative errors {es:?} observed orders {p:.3?}");
     for (i, &order) in p.iter().enumerate() {
         assert!(
             (lo..=hi).contains(&order),
-            "{scheme}: order {order:.3} between dt {} and {} outside [{lo}, {hi}] (errors {e:.3e?})",
+            "{scheme}: order {order:.3} between dt {} and {} outside [{lo}, {hi}] (errors {es:?})",
             dts[i],
             dts[i + 1]
         );
@@ -108,17 +108,19 @@ fn check_order(scheme: &str, lo: f64, hi: f64) {
 
 #[test]
 fn c0_converges_at_second_order() {
-    check_order("C0", 1.9, 2.6);
+    check_order("C0", [1e-3, 5e-4, 2.5e-4], 1.9, 2.6);
 }
 
 #[test]
 fn a6_converges_at_second_order() {
-    check_order("A6", 1.9, 2.6);
+    check_order("A6", [1e-3, 5e-4, 2.5e-4], 1.9, 2.6);
 }
 
 #[test]
 fn css_converges_at_first_order() {
-    check_order("CSS", 0.8, 1.2);
+    // Smaller steps: CSS's first-order error, proportional to the fluid's damping, must dominate
+    // the integrator's second-order one before the order settles.
+    check_order("CSS", [2.5e-4, 1.25e-4, 6.25e-5], 0.8, 1.2);
 }
 
 #[test]

@@ -125,4 +125,6 @@ fn roe_average(
 }
 
 #[cfg(test)]
+pub(crate) mod line;
+#[cfg(test)]
 mod tests;

@@ -96,8 +96,18 @@ impl BoxSpec {
                         BoxCells::Hex => cells.push(Cell::new(CellKind::Hex, &h)),
                         BoxCells::Tet => {
                             // Six paths from corner 0 to corner 6, one tet each.
-                            for t in [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]] {
-                                cells.push(Cell::new(CellKind::Tet, &[h[t[0]], h[t[1]], h[t[2]], h[t[3]]]));
+                            for t in [
+                                [0, 1, 2, 6],
+                                [0, 2, 3, 6],
+                                [0, 3, 7, 6],
+                                [0, 7, 4, 6],
+                                [0, 4, 5, 6],
+                                [0, 5, 1, 6],
+                            ] {
+                                cells.push(Cell::new(
+                                    CellKind::Tet,
+                                    &[h[t[0]], h[t[1]], h[t[2]], h[t[3]]],
+                                ));
                             }
                         }
                     }
@@ -128,7 +138,10 @@ impl BoxSpec {
                 for d in 0..3 {
                     for (side, end) in [(0usize, 0usize), (1, self.cells[d])] {
                         if nodes.iter().all(|&v| logical(v)[d] == end) {
-                            faces.push(TaggedFace { patch: (2 * d + side) as u32, nodes: nodes.clone() });
+                            faces.push(TaggedFace {
+                                patch: (2 * d + side) as u32,
+                                nodes: nodes.clone(),
+                            });
                         }
                     }
                 }
@@ -143,4 +156,3 @@ impl BoxSpec {
         })
     }
 }
-

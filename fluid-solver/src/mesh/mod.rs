@@ -16,6 +16,7 @@ pub mod boxmesh;
 pub mod cell;
 mod dual;
 pub mod geometry;
+pub mod gmsh;
 pub mod renumber;
 
 pub use cell::{Cell, CellKind};
@@ -110,11 +111,9 @@ impl Mesh {
 
     /// The boundary of this name, or an error listing the known names.
     pub fn boundary(&self, name: &str) -> Result<&Boundary, MeshError> {
-        self.boundaries.iter().find(|b| b.name == name).ok_or_else(|| {
-            MeshError::UnknownBoundary {
-                name: name.to_string(),
-                known: self.boundary_names().join(", "),
-            }
+        self.boundaries.iter().find(|b| b.name == name).ok_or_else(|| MeshError::UnknownBoundary {
+            name: name.to_string(),
+            known: self.boundary_names().join(", "),
         })
     }
 
@@ -215,4 +214,3 @@ pub fn perturb(raw: &mut RawMesh, fraction: f64, seed: u64) {
         }
     }
 }
-

@@ -186,7 +186,7 @@ impl Region {
                 }
             }
             Region::Box { lo, hi } => {
-                if (0..3).any(|k| !(hi[k] >= lo[k])) {
+                if (0..3).any(|k| hi[k].partial_cmp(&lo[k]).is_none_or(|o| o.is_lt())) {
                     return bad(format!(
                         "box: expected hi >= lo per axis, got lo {lo:?}, hi {hi:?}"
                     ));
@@ -257,12 +257,7 @@ fn half() -> f64 {
 
 impl Default for FluidNumerics {
     fn default() -> Self {
-        FluidNumerics {
-            flux: roe(),
-            limiter: van_albada(),
-            cfl: half(),
-            local_time_step: false,
-        }
+        FluidNumerics { flux: roe(), limiter: van_albada(), cfl: half(), local_time_step: false }
     }
 }
 
@@ -330,7 +325,7 @@ impl FluidSection {
                                 "expected >= 1 cell per axis".into(),
                             ));
                         }
-                        if !(b.hi[k] > b.lo[k]) {
+                        if b.hi[k].partial_cmp(&b.lo[k]).is_none_or(|o| o.is_le()) {
                             return Err((
                                 "fluid.mesh.box.hi".into(),
                                 format!(
@@ -346,7 +341,7 @@ impl FluidSection {
             }
         }
         let state_ok = |field: &str, s: &[f64; 5]| -> Result<(), (String, String)> {
-            if s.iter().any(|v| !v.is_finite()) || !(s[0] > 0.0) {
+            if s.iter().any(|v| !v.is_finite()) || s[0] <= 0.0 {
                 return Err((
                     field.to_string(),
                     format!("expected a finite [ρ, u, v, w, p] with ρ > 0, got {s:?}"),

@@ -45,9 +45,10 @@ impl PerDof {
         match self {
             PerDof::All(v) => Ok(vec![*v; n]),
             PerDof::Each(v) if v.len() == n => Ok(v.clone()),
-            PerDof::Each(v) => {
-                Err(format!("expected one number or {n} (one per entry of `dofs`), got {}", v.len()))
-            }
+            PerDof::Each(v) => Err(format!(
+                "expected one number or {n} (one per entry of `dofs`), got {}",
+                v.len()
+            )),
         }
     }
 }
@@ -130,17 +131,26 @@ impl RigidBody {
         let f = |name: &str| format!("structure.rigid.{name}");
         super::require_positive(&f("mass"), self.mass)?;
         if self.dofs.is_empty() || self.dofs.len() > 6 {
-            return Err((f("dofs"), "expected 1 to 6 of \"x\", \"y\", \"z\", \"rx\", \"ry\", \"rz\"".into()));
+            return Err((
+                f("dofs"),
+                "expected 1 to 6 of \"x\", \"y\", \"z\", \"rx\", \"ry\", \"rz\"".into(),
+            ));
         }
         for (i, d) in self.dofs.iter().enumerate() {
             let Some(k) = RIGID_DOFS.iter().position(|n| n == d) else {
-                return Err((f("dofs"), format!("unknown DOF \"{d}\": expected one of {RIGID_DOFS:?}")));
+                return Err((
+                    f("dofs"),
+                    format!("unknown DOF \"{d}\": expected one of {RIGID_DOFS:?}"),
+                ));
             };
             if self.dofs[..i].contains(d) {
                 return Err((f("dofs"), format!("DOF \"{d}\" is listed twice")));
             }
             if k >= 3 && !(self.inertia[k - 3].is_finite() && self.inertia[k - 3] > 0.0) {
-                return Err((f("inertia"), format!("DOF \"{d}\" is free: expected inertia[{}] > 0", k - 3)));
+                return Err((
+                    f("inertia"),
+                    format!("DOF \"{d}\" is free: expected inertia[{}] > 0", k - 3),
+                ));
             }
         }
         let n = self.dofs.len();
@@ -157,10 +167,14 @@ impl RigidBody {
             }
         }
         if self.wet_nodes.is_empty() || self.wet_nodes.iter().flatten().any(|x| !x.is_finite()) {
-            return Err((f("wet_nodes"), "expected at least one node of three finite coordinates".into()));
+            return Err((
+                f("wet_nodes"),
+                "expected at least one node of three finite coordinates".into(),
+            ));
         }
         for (i, e) in self.wet_elements.iter().enumerate() {
-            if !(3..=4).contains(&e.len()) || e.iter().any(|&k| k as usize >= self.wet_nodes.len()) {
+            if !(3..=4).contains(&e.len()) || e.iter().any(|&k| k as usize >= self.wet_nodes.len())
+            {
                 return Err((
                     f("wet_elements"),
                     format!(
@@ -172,10 +186,16 @@ impl RigidBody {
         }
         for p in &self.prescribed {
             if !self.dofs.contains(&p.dof) {
-                return Err((f("prescribed.dof"), format!("\"{}\" is not among dofs {:?}", p.dof, self.dofs)));
+                return Err((
+                    f("prescribed.dof"),
+                    format!("\"{}\" is not among dofs {:?}", p.dof, self.dofs),
+                ));
             }
             if !p.amplitude.is_finite() || !(p.frequency.is_finite() && p.frequency >= 0.0) {
-                return Err((f("prescribed"), "expected a finite amplitude and a frequency >= 0".into()));
+                return Err((
+                    f("prescribed"),
+                    "expected a finite amplitude and a frequency >= 0".into(),
+                ));
             }
         }
         Ok(())
@@ -188,7 +208,8 @@ mod tests {
     use std::path::Path;
 
     fn parse(body: &str) -> Result<Case, String> {
-        Case::parse(&format!("[structure.rigid]\n{body}"), Path::new("case.toml"), &[]).map_err(|e| e.to_string())
+        Case::parse(&format!("[structure.rigid]\n{body}"), Path::new("case.toml"), &[])
+            .map_err(|e| e.to_string())
     }
 
     #[test]

@@ -30,6 +30,7 @@ pub struct Control {
     pub(crate) timeouts: Timeouts,
     pub(crate) run_id: String,
     role: Role,
+    info: HelloInfo,
     /// Seconds spent waiting for samples since the last reply.
     pub(crate) waited: Duration,
     pub(crate) node: Node<ipc::Service>,
@@ -52,8 +53,16 @@ pub(crate) fn control_service(
     node: &Node<ipc::Service>,
     run_id: &str,
     role: Role,
-) -> Result<iceoryx2::service::port_factory::request_response::PortFactory<ipc::Service, Command, (), Reply, ()>, ProtocolError>
-{
+) -> Result<
+    iceoryx2::service::port_factory::request_response::PortFactory<
+        ipc::Service,
+        Command,
+        (),
+        Reply,
+        (),
+    >,
+    ProtocolError,
+> {
     node.service_builder(&services::service_name(run_id, &services::control(role))?)
         .request_response::<Command, Reply>()
         .enable_safe_overflow_for_requests(false)
@@ -69,8 +78,10 @@ pub(crate) fn hello_service(
     node: &Node<ipc::Service>,
     run_id: &str,
     role: Role,
-) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, Hello, ()>, ProtocolError>
-{
+) -> Result<
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, Hello, ()>,
+    ProtocolError,
+> {
     node.service_builder(&services::service_name(run_id, &services::hello(role))?)
         .publish_subscribe::<Hello>()
         .history_size(1)
@@ -81,7 +92,8 @@ pub(crate) fn hello_service(
 }
 
 impl Control {
-    /// Creates the node of `role`, its command server and wake events, and publishes `Hello`.
+    /// Creates the node of `role`, its command server and wake events (`announce` publishes the
+    /// `Hello` afterwards).
     pub(crate) fn open(
         run_id: &str,
         role: Role,
@@ -102,10 +114,11 @@ impl Control {
             .listener_builder()
             .create()
             .map_err(|e| ipc_err("cannot create the wake listener", e))?;
-        let wake_launcher = event(&node, run_id, services::LAUNCHER)?
-            .notifier_builder()
-            .create()
-            .map_err(|e| ipc_err("cannot create the launcher's wake notifier", e))?;
+        let wake_launcher =
+            event(&node, run_id, services::LAUNCHER)?
+                .notifier_builder()
+                .create()
+                .map_err(|e| ipc_err("cannot create the launcher's wake notifier", e))?;
         let wake_peer = event(&node, run_id, peer.name())?
             .notifier_builder()
             .create()
@@ -114,11 +127,8 @@ impl Control {
             .publisher_builder()
             .create()
             .map_err(|e| ipc_err("cannot create the hello publisher", e))?;
-        hello
-            .send_copy(info.hello(role))
-            .map_err(|e| ipc_err("cannot publish the hello", e))?;
-        let _ = wake_launcher.notify();
         Ok(Control {
+            info,
             pending: None,
             server,
             hello,
@@ -132,6 +142,16 @@ impl Control {
             waited: Duration::ZERO,
             node,
         })
+    }
+
+    /// Publishes the `Hello`: called by the endpoints once all their ports exist, so that no
+    /// sample sent after the launcher's handshake can miss a subscriber.
+    pub(crate) fn announce(&self) -> Result<(), ProtocolError> {
+        self.hello
+            .send_copy(self.info.hello(self.role))
+            .map_err(|e| ipc_err("cannot publish the hello", e))?;
+        let _ = self.wake_launcher.notify();
+        Ok(())
     }
 
     /// The role this endpoint plays.
@@ -168,9 +188,10 @@ impl Control {
 
     /// Answers the command taken last and wakes the launcher.
     pub fn reply(&mut self, reply: &Reply) -> Result<(), ProtocolError> {
-        let request = self.pending.take().ok_or_else(|| {
-            ProtocolError::Mismatch("a reply without a command to answer".into())
-        })?;
+        let request = self
+            .pending
+            .take()
+            .ok_or_else(|| ProtocolError::Mismatch("a reply without a command to answer".into()))?;
         request.send_copy(*reply).map_err(|e| {
             ProtocolError::Delivery(format!("cannot send the reply to the launcher: {e:?}"))
         })?;

@@ -161,9 +161,12 @@ impl<T: Plain> SliceReader<T> {
     ) -> Result<R, ProtocolError> {
         let start = Instant::now();
         let name = self.name;
-        let sample = wait_for(listener, watch, start + timeout, &|| format!("a sample on {name}"), || {
-            self.subscriber.receive().map_err(|e| ipc_err(&format!("cannot receive on {name}"), e))
-        });
+        let sample =
+            wait_for(listener, watch, start + timeout, &|| format!("a sample on {name}"), || {
+                self.subscriber
+                    .receive()
+                    .map_err(|e| ipc_err(&format!("cannot receive on {name}"), e))
+            });
         *waited += start.elapsed();
         let sample = sample?;
         let header = *sample.user_header();
@@ -184,8 +187,10 @@ impl<T: Plain> SliceReader<T> {
         read: impl FnOnce(&StepHeader, &[T]) -> R,
     ) -> Result<Option<R>, ProtocolError> {
         let name = self.name;
-        let sample =
-            self.subscriber.receive().map_err(|e| ipc_err(&format!("cannot receive on {name}"), e))?;
+        let sample = self
+            .subscriber
+            .receive()
+            .map_err(|e| ipc_err(&format!("cannot receive on {name}"), e))?;
         Ok(sample.map(|s| read(s.user_header(), s.payload())))
     }
 }

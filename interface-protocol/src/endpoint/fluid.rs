@@ -28,12 +28,14 @@ impl FluidEndpoint {
             0 => DEFAULT_NODES,
             n => n,
         };
-        Ok(FluidEndpoint {
+        let endpoint = FluidEndpoint {
             topology: SliceReader::create(node, run_id, services::TOPOLOGY, 1)?,
             kinematics: SliceReader::create(node, run_id, services::KINEMATICS, 0)?,
             loads: SliceWriter::create(node, run_id, services::LOADS, 0, n_nodes, timeouts)?,
             control,
-        })
+        };
+        endpoint.control.announce()?;
+        Ok(endpoint)
     }
 
     /// Waits for a topology and reads it in place.
@@ -60,6 +62,26 @@ impl FluidEndpoint {
     ) -> Result<R, ProtocolError> {
         let c = &mut self.control;
         self.kinematics.read(&c.listener, &c.watch, c.timeouts.wait, &mut c.waited, read)
+    }
+
+    /// Waits for the kinematics and answers them at once: `answer` reads the nodes in place from
+    /// the sample and writes one load per node in place into the loan (no copy either way); the
+    /// loads carry the kinematics' header.
+    pub fn answer_kinematics<R>(
+        &mut self,
+        answer: impl FnOnce(&StepHeader, &[NodeState], &mut [NodeLoad]) -> R,
+    ) -> Result<R, ProtocolError> {
+        let c = &mut self.control;
+        let loads = &mut self.loads;
+        let r = self.kinematics.read(
+            &c.listener,
+            &c.watch,
+            c.timeouts.wait,
+            &mut c.waited,
+            |h, nodes| loads.publish(*h, nodes.len(), |out| answer(h, nodes, out)),
+        )??;
+        wake(&self.control.wake_peer);
+        Ok(r)
     }
 
     /// Publishes the nodal loads for the time in `header`, written in place by `fill`.

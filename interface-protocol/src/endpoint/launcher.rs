@@ -133,7 +133,11 @@ impl LauncherLink {
 
     /// Checks both hellos against each other and the launcher's case hash; the error names both
     /// sides' values of every mismatch (protocol version, case hash, units, node counts).
-    pub fn check(fluid: &Hello, structure: &Hello, expected_case_hash: u64) -> Result<(), ProtocolError> {
+    pub fn check(
+        fluid: &Hello,
+        structure: &Hello,
+        expected_case_hash: u64,
+    ) -> Result<(), ProtocolError> {
         handshake::check(fluid, structure, expected_case_hash)
     }
 
@@ -148,7 +152,11 @@ impl LauncherLink {
             )));
         }
         let pending = peer.client.send_copy(*command).map_err(|e| {
-            ProtocolError::Delivery(format!("cannot send {} to the {}: {e:?}", command.describe(), role.name()))
+            ProtocolError::Delivery(format!(
+                "cannot send {} to the {}: {e:?}",
+                command.describe(),
+                role.name()
+            ))
         })?;
         if pending.number_of_server_connections() == 0 {
             return Err(ProtocolError::Delivery(format!(

@@ -131,6 +131,5 @@ pub(crate) fn wait_for<T>(
     }
 }
 
-
 #[cfg(test)]
 mod tests;

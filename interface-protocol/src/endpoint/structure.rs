@@ -22,12 +22,28 @@ impl StructureEndpoint {
         let node = &control.node;
         let n_nodes = info.n_surface_nodes as usize;
         let n_elements = info.n_surface_elements as usize;
-        Ok(StructureEndpoint {
-            topology: SliceWriter::create(node, run_id, services::TOPOLOGY, 1, n_elements, timeouts)?,
-            kinematics: SliceWriter::create(node, run_id, services::KINEMATICS, 0, n_nodes, timeouts)?,
+        let endpoint = StructureEndpoint {
+            topology: SliceWriter::create(
+                node,
+                run_id,
+                services::TOPOLOGY,
+                1,
+                n_elements,
+                timeouts,
+            )?,
+            kinematics: SliceWriter::create(
+                node,
+                run_id,
+                services::KINEMATICS,
+                0,
+                n_nodes,
+                timeouts,
+            )?,
             loads: SliceReader::create(node, run_id, services::LOADS, 0)?,
             control,
-        })
+        };
+        endpoint.control.announce()?;
+        Ok(endpoint)
     }
 
     /// Publishes the wet-surface elements (`header.topology_version` says which), written in place

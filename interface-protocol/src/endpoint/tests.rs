@@ -4,7 +4,9 @@
 use super::*;
 use crate::endpoint::ControlPort;
 use crate::handshake::HelloInfo;
-use crate::messages::{reply_kind, Command, Reply, NodeLoad, NodeState, Role, StepHeader, SurfaceElement};
+use crate::messages::{
+    reply_kind, Command, NodeLoad, NodeState, Reply, Role, StepHeader, SurfaceElement,
+};
 use crate::shm;
 use std::thread;
 
@@ -47,7 +49,11 @@ fn fluid_and_structure_exchange_ten_thousand_nodes_then_leave_no_file() {
                 let bad = s
                     .read_loads(|h, loads| {
                         assert_eq!(h.step, step);
-                        loads.iter().enumerate().filter(|(i, l)| l.f != [-(*i as f64) - t, -t, -1.0]).count()
+                        loads
+                            .iter()
+                            .enumerate()
+                            .filter(|(i, l)| l.f != [-(*i as f64) - t, -t, -1.0])
+                            .count()
                     })
                     .unwrap();
                 assert_eq!(bad, 0);
@@ -57,14 +63,21 @@ fn fluid_and_structure_exchange_ten_thousand_nodes_then_leave_no_file() {
     let fluid = {
         let id = id.clone();
         thread::spawn(move || {
-            let mut f = FluidEndpoint::open(&id, HelloInfo { n_surface_nodes: 0, ..info }, quick()).unwrap();
+            let mut f = FluidEndpoint::open(&id, HelloInfo { n_surface_nodes: 0, ..info }, quick())
+                .unwrap();
             both_open.wait();
             let n_el = f.read_topology(|h, e| (h.topology_version, e.len(), e[0].phi)).unwrap();
             assert_eq!(n_el, (1, 1, [1.0; 4]));
             for step in 0..3u64 {
                 let (h, sums): (StepHeader, Vec<[f64; 3]>) = f
                     .read_kinematics(|h, nodes| {
-                        (*h, nodes.iter().map(|n| [n.x[0] + n.v[0], n.x[1] + n.v[1], n.x[2] + n.v[2]]).collect())
+                        (
+                            *h,
+                            nodes
+                                .iter()
+                                .map(|n| [n.x[0] + n.v[0], n.x[1] + n.v[1], n.x[2] + n.v[2]])
+                                .collect(),
+                        )
                     })
                     .unwrap();
                 assert_eq!((h.step, h.count as usize), (step, N));
@@ -163,10 +176,16 @@ fn a_second_sample_before_the_first_is_read_is_a_delivery_error() {
 #[test]
 fn slices_grow_past_their_initial_length() {
     let id = run_id("grow");
-    let mut s = StructureEndpoint::open(&id, HelloInfo { n_surface_nodes: 8, ..Default::default() }, quick()).unwrap();
+    let mut s = StructureEndpoint::open(
+        &id,
+        HelloInfo { n_surface_nodes: 8, ..Default::default() },
+        quick(),
+    )
+    .unwrap();
     let mut f = FluidEndpoint::open(&id, HelloInfo::default(), quick()).unwrap();
     for n in [8usize, 100, 5000] {
-        s.publish_kinematics(header(0), n, |x| x.fill(NodeState { x: [1.0; 3], v: [2.0; 3] })).unwrap();
+        s.publish_kinematics(header(0), n, |x| x.fill(NodeState { x: [1.0; 3], v: [2.0; 3] }))
+            .unwrap();
         let sum = f.read_kinematics(|_, x| x.iter().map(|s| s.x[0] + s.v[2]).sum::<f64>()).unwrap();
         assert_eq!(sum, 3.0 * n as f64);
     }

@@ -15,7 +15,8 @@
 //! | 8          | step `u64`                                                                |
 //! | 8          | time, `f64` bits                                                          |
 //! | 8 + m      | metadata length `u64` m, then the metadata (postcard)                     |
-//! | per array  | name length `u16` n, name (UTF-8, n bytes), type `u8` (1 f64, 2 u64, 3 u32, 4 u8), element count `u64` k, k elements |
+//! | per array  | name length `u16` n, name (UTF-8, n bytes), type `u8` (1 f64, 2 u64, 3 u32,  |
+//! |            | 4 u8), element count `u64` k, then the k elements                         |
 //! | 8          | checksum `u64` of every preceding byte (see [`checksum`])                |
 
 use std::fs;
@@ -66,6 +67,27 @@ impl Array {
     }
 }
 
+impl From<Vec<f64>> for Array {
+    fn from(v: Vec<f64>) -> Self {
+        Array::F64(v)
+    }
+}
+impl From<Vec<u64>> for Array {
+    fn from(v: Vec<u64>) -> Self {
+        Array::U64(v)
+    }
+}
+impl From<Vec<u32>> for Array {
+    fn from(v: Vec<u32>) -> Self {
+        Array::U32(v)
+    }
+}
+impl From<Vec<u8>> for Array {
+    fn from(v: Vec<u8>) -> Self {
+        Array::U8(v)
+    }
+}
+
 /// A checkpoint could not be written or read.
 #[derive(Debug, thiserror::Error)]
 pub enum CheckpointError {
@@ -87,7 +109,10 @@ pub enum CheckpointError {
     Meta { path: String, source: postcard::Error },
     #[error("checkpoint array name `{0}` must be 1 to 65535 bytes long")]
     BadName(String),
-    #[error("checkpoint tag or part `{0}` must be non-empty, not start with `.`, and contain no `/` or `\\`")]
+    #[error(
+        "checkpoint tag or part `{0}` must be non-empty, not start with `.`, and contain no `/` \
+         or `\\`"
+    )]
     BadTag(String),
 }
 
@@ -121,8 +146,10 @@ impl Checkpoint {
             .map_err(|source| CheckpointError::Meta { path: self.origin.clone(), source })
     }
 
-    /// Stores `array` under `name`, replacing an array of the same name.
-    pub fn put(&mut self, name: &str, array: Array) -> Result<(), CheckpointError> {
+    /// Stores `array` under `name`, replacing an array of the same name:
+    /// `ck.put("rho", rho.to_vec())?`.
+    pub fn put(&mut self, name: &str, array: impl Into<Array>) -> Result<(), CheckpointError> {
+        let array = array.into();
         if name.is_empty() || name.len() > u16::MAX as usize {
             return Err(CheckpointError::BadName(name.to_string()));
         }
@@ -360,7 +387,8 @@ fn decode(bytes: &[u8], origin: String) -> Result<Checkpoint, CheckpointError> {
     let computed = checksum(&bytes[..body_end]);
     if stored != computed {
         return Err(corrupt(format!(
-            "checksum mismatch (stored {stored:016x}, computed {computed:016x}): the file was damaged"
+            "checksum mismatch (stored {stored:016x}, computed {computed:016x}): the file was \
+             damaged"
         )));
     }
     Ok(Checkpoint { step, time, meta, arrays, origin })
@@ -417,7 +445,8 @@ pub struct Found {
 
 /// The tag folder under `checkpoints_dir` with the highest step whose `parts` are all present,
 /// intact and at the same step; `None` if there is none. Incomplete or damaged folders are
-/// skipped with a warning (a run killed while writing leaves one).
+/// skipped with a warning (a run killed while writing leaves one). Candidates are ordered by the
+/// step in their file headers, so only the newest folders are read in full.
 pub fn latest(checkpoints_dir: &Path, parts: &[&str]) -> Result<Option<Found>, CheckpointError> {
     let io_err =
         |source| CheckpointError::Io { path: checkpoints_dir.display().to_string(), source };
@@ -426,43 +455,51 @@ pub fn latest(checkpoints_dir: &Path, parts: &[&str]) -> Result<Option<Found>, C
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(io_err(e)),
     };
-    let mut best: Option<Found> = None;
+    let Some(first) = parts.first() else { return Ok(None) };
+    // (step from the first part's header, tag, folder)
+    let mut candidates: Vec<(u64, String, PathBuf)> = Vec::new();
     for entry in entries {
         let entry = entry.map_err(io_err)?;
         let tag = entry.file_name().to_string_lossy().into_owned();
         if check_tag(&tag).is_err() || !entry.path().is_dir() {
             continue;
         }
-        let mut found: Option<(u64, f64)> = None;
-        let mut complete = !parts.is_empty();
+        match read_step(&part_path(&entry.path(), first)) {
+            Some(step) => candidates.push((step, tag, entry.path())),
+            None => tracing::warn!("skipping checkpoint {tag}: part `{first}` missing or damaged"),
+        }
+    }
+    candidates.sort();
+    'tags: for (_, tag, dir) in candidates.into_iter().rev() {
+        let mut at: Option<(u64, f64)> = None;
         for part in parts {
-            match Checkpoint::read_file(&part_path(&entry.path(), part)) {
-                Ok(c) if found.is_none_or(|(s, _)| s == c.step) => found = Some((c.step, c.time)),
+            match Checkpoint::read_file(&part_path(&dir, part)) {
+                Ok(c) if at.is_none_or(|(s, _)| s == c.step) => at = Some((c.step, c.time)),
                 Ok(c) => {
                     tracing::warn!(
-                        "checkpoint {tag}: part `{part}` is at step {}, others differ",
+                        "skipping checkpoint {tag}: part `{part}` is at step {}",
                         c.step
                     );
-                    complete = false;
+                    continue 'tags;
                 }
                 Err(e) => {
                     tracing::warn!("skipping checkpoint {tag}: {e}");
-                    complete = false;
+                    continue 'tags;
                 }
             }
-            if !complete {
-                break;
-            }
         }
-        if let (true, Some((step, time))) = (complete, found) {
-            let newer =
-                best.as_ref().is_none_or(|b| (step, tag.as_str()) > (b.step, b.tag.as_str()));
-            if newer {
-                best = Some(Found { tag, dir: entry.path(), step, time });
-            }
-        }
+        let (step, time) = at.expect("parts is not empty");
+        return Ok(Some(Found { tag, dir, step, time }));
     }
-    Ok(best)
+    Ok(None)
+}
+
+/// The step in a checkpoint file's header, without reading the rest.
+fn read_step(path: &Path) -> Option<u64> {
+    use std::io::Read;
+    let mut head = [0u8; 24];
+    fs::File::open(path).and_then(|mut f| f.read_exact(&mut head)).ok()?;
+    (head[..8] == *MAGIC).then(|| le8(&head[16..24]))
 }
 
 #[cfg(test)]
@@ -496,7 +533,7 @@ mod tests {
         c.put("rho", Array::F64(awkward)).unwrap();
         c.put_f64_n("velocity", &[[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]).unwrap();
         c.put("global_id", Array::U64(vec![0, u64::MAX, 1 << 40])).unwrap();
-        c.put("status", Array::U32(vec![7, u32::MAX])).unwrap();
+        c.put("status", vec![7u32, u32::MAX]).unwrap();
         c.put("phase", Array::U8(vec![0, 1, 255])).unwrap();
         c.put("empty", Array::F64(vec![])).unwrap();
         c.set_meta(&Meta { scheme: "A6".into(), newton_iterations: 3, dt: 2.5e-4 }).unwrap();

@@ -1,7 +1,8 @@
 //! Probe time series and line samples as CSV (DESIGN §7).
 //!
 //! - `probes.csv`: `time,<probe>.rho,<probe>.vx,<probe>.vy,<probe>.vz,<probe>.p` per fluid probe;
-//! - `structure_probes.csv`: `time,<probe>.ux,<probe>.uy,<probe>.uz,<probe>.vx,<probe>.vy,<probe>.vz`;
+//! - `structure_probes.csv`:
+//!   `time,<probe>.ux,<probe>.uy,<probe>.uz,<probe>.vx,<probe>.vy,<probe>.vz`;
 //! - `lines/<name>.csv`: `x,y,z,s,rho,vx,vy,vz,p,material`, one row per sample point.
 //!
 //! Numbers are written in Rust's shortest round-trip exponent form (`1.5e-3`), which Python,
@@ -27,7 +28,10 @@ pub enum ProbeError {
     BadName(String),
     #[error("line sample name `{0}` must be non-empty and contain no `/`, `\\` or line break")]
     BadLineName(String),
-    #[error("{path}: a row needs {expected} values ({probes} probes x {components} components), got {got}")]
+    #[error(
+        "{path}: a row needs {expected} values ({probes} probes x {components} components), \
+         got {got}"
+    )]
     RowLength { path: PathBuf, expected: usize, got: usize, probes: usize, components: usize },
 }
 
@@ -43,8 +47,13 @@ pub struct ProbeWriter {
 
 impl ProbeWriter {
     /// Creates `path` (truncating it) with the header for `probes` x `components`.
-    pub fn create(path: &Path, probes: &[&str], components: &[&str]) -> Result<Self, ProbeError> {
+    pub fn create<S: AsRef<str>>(
+        path: &Path,
+        probes: &[S],
+        components: &[&str],
+    ) -> Result<Self, ProbeError> {
         for name in probes {
+            let name = name.as_ref();
             if name.is_empty() || name.contains([',', '"', '\n', '\r']) {
                 return Err(ProbeError::BadName(name.to_string()));
             }
@@ -54,7 +63,7 @@ impl ProbeWriter {
         let mut header = String::from("time");
         for p in probes {
             for c in components {
-                header.push_str(&format!(",{p}.{c}"));
+                header.push_str(&format!(",{}.{c}", p.as_ref()));
             }
         }
         writeln!(out, "{header}").map_err(io_err)?;
@@ -69,12 +78,12 @@ impl ProbeWriter {
     }
 
     /// `probes.csv` in `dir` with [`FLUID_COMPONENTS`].
-    pub fn fluid(dir: &Path, probes: &[&str]) -> Result<Self, ProbeError> {
+    pub fn fluid<S: AsRef<str>>(dir: &Path, probes: &[S]) -> Result<Self, ProbeError> {
         Self::create(&dir.join("probes.csv"), probes, FLUID_COMPONENTS)
     }
 
     /// `structure_probes.csv` in `dir` with [`STRUCTURE_COMPONENTS`].
-    pub fn structure(dir: &Path, probes: &[&str]) -> Result<Self, ProbeError> {
+    pub fn structure<S: AsRef<str>>(dir: &Path, probes: &[S]) -> Result<Self, ProbeError> {
         Self::create(&dir.join("structure_probes.csv"), probes, STRUCTURE_COMPONENTS)
     }
 
@@ -209,7 +218,8 @@ mod tests {
     fn structure_probes_flush_on_drop_and_check_row_length() {
         let dir = tempfile::tempdir().unwrap();
         {
-            let mut w = ProbeWriter::structure(dir.path(), &["tip"]).unwrap();
+            let names = vec!["tip".to_string()];
+            let mut w = ProbeWriter::structure(dir.path(), &names).unwrap();
             let err = w.write_row(0.0, &[1.0; 5]).unwrap_err();
             assert!(err.to_string().contains("needs 6 values"), "{err}");
             w.write_row(0.5, &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]).unwrap();

@@ -45,6 +45,12 @@ impl Timers {
         }
     }
 
+    /// Adds the time elapsed since `start` to `bucket`, for spans a closure cannot wrap:
+    /// `let t0 = Instant::now(); ...; timers.add_since(bucket::LOADS, t0);`
+    pub fn add_since(&mut self, bucket: &'static str, start: Instant) {
+        self.add(bucket, start.elapsed());
+    }
+
     /// Runs `f`, charging its wall time to `bucket`.
     pub fn time<R>(&mut self, bucket: &'static str, f: impl FnOnce() -> R) -> R {
         let start = Instant::now();
@@ -69,7 +75,8 @@ impl Timers {
     }
 }
 
-/// Crate versions of the processes of a run, e.g. `{"interface-protocol": "0.1.0", "hdf5": "1.10.8"}`.
+/// Versions this crate knows: `{"interface-protocol": "0.1.0", "hdf5": "1.10.8"}` (the HDF5
+/// library linked at run time); each process adds its own crate.
 pub fn versions() -> BTreeMap<String, String> {
     let (a, b, c) = hdf5::library_version();
     BTreeMap::from([
@@ -138,6 +145,7 @@ mod tests {
         t.add(bucket::RESIDUAL, Duration::from_millis(12));
         let x = t.time(bucket::LOADS, || 7);
         assert_eq!(x, 7);
+        t.add_since(bucket::LOADS, Instant::now());
         assert_eq!(t.get(bucket::RESIDUAL), Duration::from_millis(42));
         assert_eq!(t.get(bucket::TRACKING), Duration::ZERO);
         assert!(t.total() >= Duration::from_millis(47));

@@ -18,7 +18,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "rigid-structure", version, about = "Rigid-body structure participant of the FSI protocol")]
+#[command(
+    name = "rigid-structure",
+    version,
+    about = "Rigid-body structure participant of the FSI protocol"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Cmd,
@@ -52,7 +56,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(case_path: &std::path::Path, couple: Option<&str>, out: Option<PathBuf>, set: &[String]) -> Result<(), String> {
+fn run(
+    case_path: &std::path::Path,
+    couple: Option<&str>,
+    out: Option<PathBuf>,
+    set: &[String],
+) -> Result<(), String> {
     let case = Case::load(case_path, set).map_err(|e| e.to_string())?;
     let out = out
         .or_else(|| case.output.dir.as_ref().map(|d| case.dir().join(d)))
@@ -67,8 +76,9 @@ fn run(case_path: &std::path::Path, couple: Option<&str>, out: Option<PathBuf>, 
         n_surface_elements: solver.body.elements.len() as u64,
         case_hash: case.hash(),
     };
-    let mut endpoint = StructureEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))
-        .map_err(|e| format!("cannot join run {run_id}: {e}"))?;
+    let mut endpoint =
+        StructureEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))
+            .map_err(|e| format!("cannot join run {run_id}: {e}"))?;
     let result = serve(&mut endpoint, &mut solver);
     // Ports and node go before the process does, whatever happened.
     drop(endpoint);

@@ -31,7 +31,9 @@ impl Body {
     pub fn new(r: &RigidBody) -> Body {
         let dofs = r.dof_indices();
         let n = dofs.len();
-        let values = |v: &interface_protocol::case::PerDof| v.values(n).expect("validated by the case parser");
+        let values = |v: &interface_protocol::case::PerDof| {
+            v.values(n).expect("validated by the case parser")
+        };
         let m = dofs.iter().map(|&d| if d < 3 { r.mass } else { r.inertia[d - 3] }).collect();
         let elements = r
             .wet_elements

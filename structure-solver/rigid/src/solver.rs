@@ -33,11 +33,12 @@ fn io_failure(what: &str, e: std::io::Error) -> Failure {
 impl RigidSolver {
     /// The solver of a case's `[structure.rigid]` writing into `out`.
     pub fn new(case: &Case, out: PathBuf) -> Result<RigidSolver, String> {
-        let rigid = case
-            .structure
-            .as_ref()
-            .and_then(|s| s.rigid.as_ref())
-            .ok_or_else(|| format!("{}: rigid-structure needs a [structure.rigid] section", case.source.path.display()))?;
+        let rigid = case.structure.as_ref().and_then(|s| s.rigid.as_ref()).ok_or_else(|| {
+            format!(
+                "{}: rigid-structure needs a [structure.rigid] section",
+                case.source.path.display()
+            )
+        })?;
         let body = Body::new(rigid);
         let mut state = Staggered::new(case.coupling.scheme, &body.u0, &body.v0);
         body.impose(0.0, &mut state.u, &mut state.v, Some(&mut state.a));
@@ -128,8 +129,19 @@ impl RigidSolver {
     }
 
     /// Publishes the kinematics (`up`, `vp` when `predicted`, else `u`, `v`) for time `t`.
-    fn publish(&self, ep: &mut StructureEndpoint, step: u64, t: f64, dt: f64, predicted: bool) -> Result<(), Failure> {
-        let (u, v) = if predicted { (&self.state.up, &self.state.vp) } else { (&self.state.u, &self.state.v) };
+    fn publish(
+        &self,
+        ep: &mut StructureEndpoint,
+        step: u64,
+        t: f64,
+        dt: f64,
+        predicted: bool,
+    ) -> Result<(), Failure> {
+        let (u, v) = if predicted {
+            (&self.state.up, &self.state.vp)
+        } else {
+            (&self.state.u, &self.state.v)
+        };
         let header = StepHeader { step, time: t, dt, topology_version: 1, count: 0 };
         ep.publish_kinematics(header, self.n_nodes(), |nodes| self.body.node_states(u, v, nodes))?;
         Ok(())
@@ -193,7 +205,9 @@ impl Handler<StructureEndpoint> for RigidSolver {
             p => {
                 return Err(Failure::new(
                     failure_code::UNSUPPORTED,
-                    format!("the structure has no Advance phase {p} (expected START, PREDICT or CORRECT)"),
+                    format!(
+                    "the structure has no Advance phase {p} (expected START, PREDICT or CORRECT)"
+                ),
                 ))
             }
         }
@@ -202,14 +216,22 @@ impl Handler<StructureEndpoint> for RigidSolver {
 
     fn checkpoint(&mut self, _ep: &mut StructureEndpoint, tag: &str) -> Result<(), Failure> {
         let dir = self.out.join("checkpoints").join(tag);
-        std::fs::create_dir_all(&dir).map_err(|e| io_failure("cannot create the checkpoint folder", e))?;
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| io_failure("cannot create the checkpoint folder", e))?;
         let mut text = format!("# rigid-structure state at t = {:.17e}\ndof,u,v,a\n", self.t);
         for (i, &d) in self.body.dofs.iter().enumerate() {
             let s = &self.state;
-            text += &format!("{},{:.17e},{:.17e},{:.17e}\n", interface_protocol::case::RIGID_DOFS[d], s.u[i], s.v[i], s.a[i]);
+            text += &format!(
+                "{},{:.17e},{:.17e},{:.17e}\n",
+                interface_protocol::case::RIGID_DOFS[d],
+                s.u[i],
+                s.v[i],
+                s.a[i]
+            );
         }
         self.probes.flush().map_err(|e| io_failure("cannot write structure_probes.csv", e))?;
-        std::fs::write(dir.join("rigid-structure.csv"), text).map_err(|e| io_failure("cannot write the checkpoint", e))
+        std::fs::write(dir.join("rigid-structure.csv"), text)
+            .map_err(|e| io_failure("cannot write the checkpoint", e))
     }
 
     fn finish(&mut self, _ep: &mut StructureEndpoint) -> Result<(), Failure> {
@@ -249,7 +271,8 @@ mod tests {
     #[test]
     fn central_difference_and_implicit_midpoint_converge_at_second_order() {
         for scheme in ["C0", "CSS", "A6"] {
-            let e: Vec<f64> = [4e-3, 2e-3, 1e-3].iter().map(|&dt| final_error(scheme, dt)).collect();
+            let e: Vec<f64> =
+                [4e-3, 2e-3, 1e-3].iter().map(|&dt| final_error(scheme, dt)).collect();
             let p = (e[1] / e[2]).log2();
             assert!((1.9..2.1).contains(&p), "{scheme}: errors {e:?}, order {p}");
             assert!(e[2] < 1e-5, "{scheme}: error {}", e[2]);
@@ -267,7 +290,10 @@ mod tests {
         assert!((s.state.u[0] - 0.002 * (1.0 - (w * 1.0).cos())).abs() < 1e-15);
         let csv = std::fs::read_to_string(dir.path().join("structure_probes.csv")).unwrap();
         let mut lines = csv.lines();
-        assert_eq!(lines.next().unwrap(), "time,piston.ux,piston.uy,piston.uz,piston.vx,piston.vy,piston.vz");
+        assert_eq!(
+            lines.next().unwrap(),
+            "time,piston.ux,piston.uy,piston.uz,piston.vx,piston.vy,piston.vz"
+        );
         assert_eq!(lines.count(), 101);
     }
 }

@@ -34,8 +34,9 @@ pub struct Frame {
     pub xc: Vector3<f64>,
     /// `ω̄ = Σ_j gx[j] δx_j + gr[j] δω_j`: frame spin in frame components from global nodal
     /// translations and spins.
-    pub gx: Vec<Matrix3<f64>>,
-    pub gr: Vec<Matrix3<f64>>,
+    /// (Up to 4 nodes; entries past the element's node count are zero.)
+    pub gx: [Matrix3<f64>; 4],
+    pub gr: [Matrix3<f64>; 4],
 }
 
 fn row(v: Vector3<f64>) -> nalgebra::RowVector3<f64> {
@@ -47,8 +48,8 @@ fn row(v: Vector3<f64>) -> nalgebra::RowVector3<f64> {
 pub fn frame(rule: FrameRule, x: &[Vector3<f64>], r: &[Matrix3<f64>]) -> Frame {
     let n = x.len();
     let xc = x.iter().sum::<Vector3<f64>>() / n as f64;
-    let mut gx = vec![Matrix3::zeros(); n];
-    let mut gr = vec![Matrix3::zeros(); n];
+    let mut gx = [Matrix3::zeros(); 4];
+    let mut gr = [Matrix3::zeros(); 4];
     match rule {
         FrameRule::Triangle | FrameRule::Quad => {
             // p, q: the two spanning vectors; a = p × q gives e3, b (⟂ a) gives e1.
@@ -141,16 +142,16 @@ impl Reference {
         let n = x.len();
         let f = frame(self.rule, x, r);
         let et = f.e.transpose();
-        let mut bl = Vec::with_capacity(n);
-        let mut tinv = Vec::with_capacity(n);
+        let mut bl = [Vector3::zeros(); 4];
+        let mut tinv = [Matrix3::zeros(); 4];
         for i in 0..n {
             let bi = et * (x[i] - f.xc);
             let ud = bi - self.a[i];
             let th = log(&(et * r[i] * self.e0));
             d[6 * i..6 * i + 3].copy_from_slice(ud.as_slice());
             d[6 * i + 3..6 * i + 6].copy_from_slice(th.as_slice());
-            bl.push(bi);
-            tinv.push(tangent_inverse(&th));
+            bl[i] = bi;
+            tinv[i] = tangent_inverse(&th);
         }
         if let Some(bm) = b {
             bm.fill(0.0);

@@ -3,6 +3,7 @@
 //! total-Lagrangian tetrahedron `tet4`, and the element container the assembly loops over.
 
 pub mod beam;
+pub mod bt4;
 pub mod corotation;
 pub mod dkt;
 pub mod element;

@@ -1,7 +1,7 @@
 //! The critical step of central differences, `Δt_cr = 2/ω_max` (DESIGN §6: all stiffness
 //! included), estimated from the model: the elements' own estimate (`Model::stable_dt`), a
-//! power iteration on `M⁻¹K`, and Gershgorin's bound `ω_max² <= max_i Σ_j |K_ij| / sqrt(m_i m_j)`
-//! which never overestimates the step.
+//! matrix-free power iteration on `M⁻¹K` through the internal force, and Gershgorin's bound
+//! `ω_max² <= max_i Σ_j |K_ij| / sqrt(m_i m_j)` which never overestimates the step.
 
 use faer::sparse::Triplet;
 
@@ -26,24 +26,30 @@ impl CriticalDt {
     }
 }
 
-/// Estimates the critical step from the tangent at `t` (free dofs with mass only).
-pub fn critical_dt(model: &mut dyn Model, t: f64, iterations: usize) -> CriticalDt {
+/// Estimates the critical step at the committed state: Gershgorin from the tangent at `t`
+/// (infinite when the model has no tangent, as explicit-only elements), and a matrix-free power
+/// iteration on `M^-1/2 K M^-1/2` with `K v ≈ (f_int(u + δ v) - f_int(u)) / δ` (free dofs with
+/// mass only, increments of at most `probe` in any dof). The model is reverted afterwards.
+pub fn critical_dt(model: &mut dyn Model, t: f64, iterations: usize, probe: f64) -> CriticalDt {
     let n = model.n_dof();
     let mut k: Vec<Triplet<usize, usize, f64>> = Vec::new();
     model.tangent(t, &mut k);
     let m = model.lumped_mass().to_vec();
     let free: Vec<bool> =
         model.constrained().iter().zip(&m).map(|(&c, &m)| !c && m > 0.0).collect();
-    let inv_sqrt: Vec<f64> = m.iter().zip(&free).map(|(&m, &f)| if f { 1.0 / m.sqrt() } else { 0.0 }).collect();
-    // A = M^-1/2 K M^-1/2 on the free dofs.
+    let inv_sqrt: Vec<f64> =
+        m.iter().zip(&free).map(|(&m, &f)| if f { 1.0 / m.sqrt() } else { 0.0 }).collect();
     let mut rows = vec![0.0; n];
     for e in &k {
         rows[e.row] += (e.val * inv_sqrt[e.row] * inv_sqrt[e.col]).abs();
     }
     let bound = rows.iter().cloned().fold(0.0, f64::max);
-    let mut x: Vec<f64> =
-        (0..n).map(|i| if free[i] { 1.0 + 0.37 * ((i * 7919) % 101) as f64 / 101.0 } else { 0.0 }).collect();
-    let mut y = vec![0.0; n];
+    let mut f0 = vec![0.0; n];
+    model.internal_force(&mut f0);
+    let mut x: Vec<f64> = (0..n)
+        .map(|i| if free[i] { 1.0 + 0.37 * ((i * 7919) % 101) as f64 / 101.0 } else { 0.0 })
+        .collect();
+    let (mut du, mut f1) = (vec![0.0; n], vec![0.0; n]);
     let mut lambda = 0.0;
     for _ in 0..iterations {
         let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -51,12 +57,20 @@ pub fn critical_dt(model: &mut dyn Model, t: f64, iterations: usize) -> Critical
             break;
         }
         x.iter_mut().for_each(|v| *v /= norm);
-        y.fill(0.0);
-        for e in &k {
-            y[e.row] += e.val * inv_sqrt[e.row] * inv_sqrt[e.col] * x[e.col];
+        for i in 0..n {
+            du[i] = inv_sqrt[i] * x[i];
         }
-        lambda = x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
-        std::mem::swap(&mut x, &mut y);
+        let scale = probe / du.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+        du.iter_mut().for_each(|v| *v *= scale);
+        model.apply_increment(&du);
+        model.internal_force(&mut f1);
+        model.revert();
+        // y = M^-1/2 K M^-1/2 x.
+        for i in 0..n {
+            f1[i] = inv_sqrt[i] * (f1[i] - f0[i]) / scale;
+        }
+        lambda = x.iter().zip(&f1).map(|(a, b)| a * b).sum::<f64>();
+        std::mem::swap(&mut x, &mut f1);
     }
     let dt = |l: f64| if l > 0.0 { 2.0 / l.sqrt() } else { f64::INFINITY };
     CriticalDt { element: model.stable_dt(), power: dt(lambda), gershgorin: dt(bound) }

@@ -48,10 +48,12 @@ struct Piston {
 
 impl Piston {
     fn new(law: PistonFluid, out: &Path) -> Result<Piston, String> {
-        std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+        std::fs::create_dir_all(out)
+            .map_err(|e| format!("cannot create {}: {e}", out.display()))?;
         let path = out.join("probes.csv");
-        let mut probes =
-            BufWriter::new(File::create(&path).map_err(|e| format!("cannot create {}: {e}", path.display()))?);
+        let mut probes = BufWriter::new(
+            File::create(&path).map_err(|e| format!("cannot create {}: {e}", path.display()))?,
+        );
         let p = &law.probe;
         writeln!(probes, "time,{p}.rho,{p}.vx,{p}.vy,{p}.vz,{p}.p").map_err(|e| e.to_string())?;
         Ok(Piston { law, probes })
@@ -64,8 +66,15 @@ impl Piston {
     }
 
     /// Reads the kinematics, publishes the loads at `t`, writes the probe row.
-    fn respond(&mut self, ep: &mut FluidEndpoint, step: u64, t: f64, dt: f64) -> Result<(), Failure> {
-        let (v, n) = ep.read_kinematics(|_, nodes: &[NodeState]| (mean_velocity(nodes), nodes.len()))?;
+    fn respond(
+        &mut self,
+        ep: &mut FluidEndpoint,
+        step: u64,
+        t: f64,
+        dt: f64,
+    ) -> Result<(), Failure> {
+        let (v, n) =
+            ep.read_kinematics(|_, nodes: &[NodeState]| (mean_velocity(nodes), nodes.len()))?;
         let Some(v) = v else {
             return Err(Failure::new(failure_code::PROTOCOL, "the kinematics hold no wet node"));
         };
@@ -73,13 +82,20 @@ impl Piston {
         let per_node = -self.law.area * p / n as f64;
         let header = StepHeader { step, time: t, dt, topology_version: 1, count: 0 };
         let normal = self.law.normal;
-        ep.publish_loads(header, n, |loads: &mut [NodeLoad]| loads.fill(NodeLoad { f: normal.map(|c| per_node * c) }))?;
-        self.row(t, v, p).map_err(|e| Failure::new(failure_code::IO, format!("cannot write probes.csv: {e}")))
+        ep.publish_loads(header, n, |loads: &mut [NodeLoad]| {
+            loads.fill(NodeLoad { f: normal.map(|c| per_node * c) })
+        })?;
+        self.row(t, v, p)
+            .map_err(|e| Failure::new(failure_code::IO, format!("cannot write probes.csv: {e}")))
     }
 
     fn row(&mut self, t: f64, v: [f64; 3], p: f64) -> std::io::Result<()> {
         let rho = self.law.rho0 + (p - self.law.p0) / (self.law.c0 * self.law.c0);
-        writeln!(self.probes, "{t:.17e},{rho:.17e},{:.17e},{:.17e},{:.17e},{p:.17e}", v[0], v[1], v[2])
+        writeln!(
+            self.probes,
+            "{t:.17e},{rho:.17e},{:.17e},{:.17e},{:.17e},{p:.17e}",
+            v[0], v[1], v[2]
+        )
     }
 }
 
@@ -114,7 +130,9 @@ impl Handler<FluidEndpoint> for Piston {
 
     fn checkpoint(&mut self, _ep: &mut FluidEndpoint, _tag: &str) -> Result<(), Failure> {
         // The face has no state of its own: a checkpoint only flushes the probes.
-        self.probes.flush().map_err(|e| Failure::new(failure_code::IO, format!("cannot write probes.csv: {e}")))
+        self.probes
+            .flush()
+            .map_err(|e| Failure::new(failure_code::IO, format!("cannot write probes.csv: {e}")))
     }
 
     fn finish(&mut self, ep: &mut FluidEndpoint) -> Result<(), Failure> {
@@ -133,7 +151,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(case_path: &Path, couple: Option<&str>, out: Option<PathBuf>, set: &[String]) -> Result<(), String> {
+fn run(
+    case_path: &Path,
+    couple: Option<&str>,
+    out: Option<PathBuf>,
+    set: &[String],
+) -> Result<(), String> {
     let case = Case::load(case_path, set).map_err(|e| e.to_string())?;
     let law = case.fluid.as_ref().and_then(|f| f.piston.clone()).ok_or_else(|| {
         format!("{}: piston-fluid needs a [fluid.piston] section", case_path.display())
@@ -153,8 +176,9 @@ fn run(case_path: &Path, couple: Option<&str>, out: Option<PathBuf>, set: &[Stri
         return piston.probes.flush().map_err(|e| format!("cannot write probes.csv: {e}"));
     };
     let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
-    let mut endpoint = FluidEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))
-        .map_err(|e| format!("cannot join run {run_id}: {e}"))?;
+    let mut endpoint =
+        FluidEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))
+            .map_err(|e| format!("cannot join run {run_id}: {e}"))?;
     let result = serve(&mut endpoint, &mut piston);
     drop(endpoint);
     result.map_err(|e| format!("run {run_id} stopped: {e}"))

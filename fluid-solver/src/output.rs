@@ -1,0 +1,63 @@
+//! Field output of the fluid: the mesh and nodal ρ, velocity, p (and Mach) as an XDMF/HDF5 time
+//! series (`fluid.h5` + `fluid.xdmf`) through `interface_protocol::io::xdmf`.
+
+use crate::eos::Eos;
+use crate::mesh::{CellKind, Mesh};
+use interface_protocol::io::xdmf::{
+    self, CellBlock, Connectivity, Field, Location, TimeSeriesWriter, Values,
+};
+use std::path::Path;
+
+/// Opens `fluid.h5`/`fluid.xdmf` in `dir` and writes the mesh (cells grouped by kind).
+pub fn create_writer(dir: &Path, mesh: &Mesh) -> Result<TimeSeriesWriter, xdmf::XdmfError> {
+    let kinds = [
+        (CellKind::Tet, xdmf::CellKind::Tet4),
+        (CellKind::Hex, xdmf::CellKind::Hex8),
+        (CellKind::Prism, xdmf::CellKind::Wedge6),
+        (CellKind::Pyramid, xdmf::CellKind::Pyramid5),
+    ];
+    // gmsh and VTK/XDMF share the node order of these linear cells.
+    let connectivity: Vec<(xdmf::CellKind, Vec<u32>)> = kinds
+        .iter()
+        .map(|&(ours, theirs)| {
+            let c: Vec<u32> = mesh
+                .cells
+                .iter()
+                .filter(|c| c.kind == ours)
+                .flat_map(|c| c.nodes().to_vec())
+                .collect();
+            (theirs, c)
+        })
+        .filter(|(_, c)| !c.is_empty())
+        .collect();
+    let blocks: Vec<CellBlock> = connectivity
+        .iter()
+        .map(|(kind, c)| CellBlock { kind: *kind, connectivity: Connectivity::U32(c) })
+        .collect();
+    TimeSeriesWriter::create(dir, "fluid", &xdmf::Mesh { points: &mesh.coords, blocks: &blocks })
+}
+
+/// Writes one time step of the primitive fields.
+pub fn write_fields(
+    writer: &mut TimeSeriesWriter,
+    eos: &Eos,
+    time: f64,
+    prim: &[[f64; 5]],
+) -> Result<(), xdmf::XdmfError> {
+    let rho: Vec<f64> = prim.iter().map(|w| w[0]).collect();
+    let p: Vec<f64> = prim.iter().map(|w| w[4]).collect();
+    let v: Vec<[f64; 3]> = prim.iter().map(|w| [w[1], w[2], w[3]]).collect();
+    let mach: Vec<f64> = prim
+        .iter()
+        .map(|w| (w[1] * w[1] + w[2] * w[2] + w[3] * w[3]).sqrt() / eos.sound_speed(w[0], w[4]))
+        .collect();
+    writer.write_step(
+        time,
+        &[
+            Field { name: "rho", location: Location::Node, values: Values::Scalar(&rho) },
+            Field { name: "velocity", location: Location::Node, values: Values::Vector(&v) },
+            Field { name: "p", location: Location::Node, values: Values::Scalar(&p) },
+            Field { name: "mach", location: Location::Node, values: Values::Scalar(&mach) },
+        ],
+    )
+}
