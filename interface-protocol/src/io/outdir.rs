@@ -28,7 +28,8 @@ pub const RUN_OUTPUTS: &[&str] = &[
 pub enum Policy {
     /// Create it; refuse if it exists and is not empty.
     Fresh,
-    /// Create it; if it exists, remove the previous run's outputs ([`RUN_OUTPUTS`]) first.
+    /// Create it; if it exists, remove the previous run's outputs ([`RUN_OUTPUTS`]) first,
+    /// `checkpoints/` included: never combine it with a restart from the same folder.
     Overwrite,
     /// It must exist already (the launcher made it); write into it as is.
     Existing,
