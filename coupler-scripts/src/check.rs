@@ -26,12 +26,16 @@ pub fn check(case_file: &Path, overrides: &[String]) -> anyhow::Result<String> {
         s.dt,
         s.t_end,
         s.n_steps,
-        seq.step_dt(s.n_steps.saturating_sub(1)),
+        round12(seq.step_dt(s.n_steps.saturating_sub(1))),
         case.coupling.timeout_s
     )?;
-    let fluid = case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
-    let structure =
-        case.structure.as_ref().map(|s| s.command()).unwrap_or_else(|| vec!["structure-solver".into()]);
+    let fluid =
+        case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
+    let structure = case
+        .structure
+        .as_ref()
+        .map(|s| s.command())
+        .unwrap_or_else(|| vec!["structure-solver".into()]);
     for (role, cmd) in [(Role::Fluid, fluid), (Role::Structure, structure)] {
         let found = match cmd.first().map(|p| resolve_program(p, role)) {
             Some(Ok(p)) => format!("({})", p.display()),
@@ -51,4 +55,9 @@ pub fn check(case_file: &Path, overrides: &[String]) -> anyhow::Result<String> {
     )?;
     writeln!(w, "  case hash  {:016x}", case.hash())?;
     Ok(out)
+}
+
+/// `v` to 12 significant digits, so a last step of 1e-3 does not print as 1.0000000000000009e-3.
+fn round12(v: f64) -> f64 {
+    format!("{v:.11e}").parse().unwrap_or(v)
 }

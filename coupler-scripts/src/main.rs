@@ -20,7 +20,8 @@ enum Cmd {
     Run {
         /// The case file (TOML).
         case: PathBuf,
-        /// Output folder (default: the case's output.dir, else runs/<case>-<timestamp>).
+        /// Output folder (default: the case's output.dir, relative to the case file, else
+        /// runs/<case>-<timestamp>).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Overrides a case key, e.g. --set coupling.dt=1e-4 (repeatable).
@@ -44,11 +45,23 @@ enum Cmd {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<String>,
     },
+    /// Benchmarks; prints JSON on stdout.
+    Bench {
+        #[command(subcommand)]
+        what: BenchCmd,
+    },
     /// Writes PNG plots of a run folder's probe files into DIR/plots.
     Plot {
         /// A run folder (holding probes.csv and/or structure_probes.csv).
         dir: PathBuf,
     },
+}
+
+#[derive(Debug, Subcommand)]
+enum BenchCmd {
+    /// Round trip of kinematics out and loads back over shared memory (and a Unix socket for
+    /// comparison) at 1e3 to 1e6 wet nodes.
+    Ipc,
 }
 
 fn main() -> ExitCode {
@@ -84,6 +97,23 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
+        Cmd::Bench { what: BenchCmd::Ipc } => {
+            let run_id = coupler_scripts::run::new_run_id();
+            let result =
+                interface_protocol::bench::run(&run_id, &interface_protocol::bench::DEFAULT_SIZES)
+                    .map_err(|e| e.to_string())
+                    .and_then(|b| serde_json::to_string_pretty(&b).map_err(|e| e.to_string()));
+            match result {
+                Ok(json) => {
+                    println!("{json}");
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("fsi: error: bench ipc: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Cmd::Plot { dir } => match plot::plot_dir(&dir) {
             Ok(files) => {
                 for f in files {

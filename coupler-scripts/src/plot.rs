@@ -20,7 +20,8 @@ pub fn read_csv(path: &Path) -> anyhow::Result<Table> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
-    let (_, header) = lines.next().ok_or_else(|| anyhow::anyhow!("{}: empty file", path.display()))?;
+    let (_, header) =
+        lines.next().ok_or_else(|| anyhow::anyhow!("{}: empty file", path.display()))?;
     let columns: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
     let mut rows = Vec::new();
     for (i, line) in lines {

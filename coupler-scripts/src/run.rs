@@ -18,7 +18,7 @@ use interface_protocol::messages::{Command, Hello, Reply, Role};
 use interface_protocol::shm;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 /// Longest wait between two checks of the children and of signals.
@@ -89,9 +89,6 @@ struct LauncherReport<'a> {
     dt: f64,
     t_end: f64,
     overrides: &'a [String],
-    /// The structure's energy ledger (`energy.json` in the run folder), when it writes one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    energy: Option<serde_json::Value>,
 }
 
 /// A fresh run id: `r<pid>-<nanoseconds>` in hex (unique per process and instant).
@@ -115,6 +112,8 @@ struct Session<'a> {
     timeout: Duration,
     timeout_s: f64,
     ipc_wait: Duration,
+    /// From the start of `fsi` to both `Hello`s checked.
+    startup: Duration,
     solver: BTreeMap<&'static str, SolverTime>,
     bar: &'a mut Bar,
 }
@@ -126,20 +125,27 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     let case = Case::load(&opts.case_file, &opts.overrides)?;
     let settings = SchemeSettings::of_case(&case);
     let mut seq = Sequencer::new(settings)?;
-    let fluid_cmd = case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
-    let structure_cmd =
-        case.structure.as_ref().map(|s| s.command()).unwrap_or_else(|| vec!["structure-solver".into()]);
+    let fluid_cmd =
+        case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
+    let structure_cmd = case
+        .structure
+        .as_ref()
+        .map(|s| s.command())
+        .unwrap_or_else(|| vec!["structure-solver".into()]);
 
+    let run_id = opts.run_id.clone().unwrap_or_else(new_run_id);
+    interface_protocol::services::validate_run_id(&run_id)?;
     let dir = match (&opts.out, &case.output.dir) {
         (Some(d), _) => d.clone(),
-        (None, Some(d)) => PathBuf::from(d),
+        // Relative to the case file, as the participants read it.
+        (None, Some(d)) => case.dir().join(d),
         (None, None) => default_run_dir(&opts.case_file, SystemTime::now()),
     };
     let out = OutputDir::create(&dir, Policy::from_force(opts.force))
         .map_err(|e| RunError::Setup(e.to_string()))?;
     let out_dir = std::fs::canonicalize(out.path()).unwrap_or_else(|_| out.path().to_path_buf());
-    let case_file = std::fs::canonicalize(&opts.case_file).unwrap_or_else(|_| opts.case_file.clone());
-    let run_id = opts.run_id.clone().unwrap_or_else(new_run_id);
+    let case_file =
+        std::fs::canonicalize(&opts.case_file).unwrap_or_else(|_| opts.case_file.clone());
 
     let mut bar = Bar::new(settings.t_end, opts.quiet);
     bar.println(&format!(
@@ -156,6 +162,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         timeout: Duration::from_secs_f64(case.coupling.timeout_s),
         timeout_s: case.coupling.timeout_s,
         ipc_wait: Duration::ZERO,
+        startup: Duration::ZERO,
         solver: BTreeMap::new(),
         bar: &mut bar,
     };
@@ -168,7 +175,10 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     let mut steps = 0;
     let result = session
         .start(&run_id, &args, &structure_cmd, &fluid_cmd, case.hash())
-        .and_then(|()| session.drive(&mut seq, &mut steps))
+        .and_then(|()| {
+            session.startup = start.elapsed();
+            session.drive(&mut seq, &mut steps)
+        })
         .and_then(|()| session.wait_exits());
     let result = match result {
         Err(e) => Err(session.explain(e)),
@@ -179,7 +189,8 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         Some(link) => link.remove_resources(),
         None => shm::cleanup_run(&run_id),
     };
-    let (ipc_wait, solver) = (session.ipc_wait, session.solver.clone());
+    let launcher = [("startup", session.startup), ("ipc_wait", session.ipc_wait)];
+    let solver = session.solver.clone();
     drop(session);
     let wall = start.elapsed();
     let status = match (&result, &cleaned) {
@@ -195,12 +206,13 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         &run_id,
         &status,
         (steps, final_time),
-        (wall, ipc_wait, &solver),
+        (wall, launcher, &solver),
     );
     bar.finish();
     result?;
     cleaned?;
-    reported.map_err(|e| RunError::Setup(format!("cannot write {}: {e}", out.run_json().display())))?;
+    reported
+        .map_err(|e| RunError::Setup(format!("cannot write {}: {e}", out.run_json().display())))?;
     Ok(RunSummary { out_dir, steps, wall })
 }
 
@@ -231,7 +243,7 @@ impl Session<'_> {
 
     /// Sends the scheme's commands until both participants acknowledged `Finish`.
     fn drive(&mut self, seq: &mut Sequencer, steps: &mut u64) -> Result<(), RunError> {
-        while let Some((role, cmd)) = seq.next() {
+        while let Some((role, cmd)) = seq.next_command() {
             let reply = self.command(role, &cmd)?;
             let progress = match seq.accept(role, &reply) {
                 Err(e @ SchemeError::Failed { .. }) => {
@@ -264,7 +276,8 @@ impl Session<'_> {
         let deadline = Instant::now() + self.timeout;
         let what = format!("answer {}", cmd.describe());
         let waited = Instant::now();
-        let reply = self.in_slices(role, deadline, what, |link, until| link.wait_reply(role, until));
+        let reply =
+            self.in_slices(role, deadline, what, |link, until| link.wait_reply(role, until));
         self.ipc_wait += waited.elapsed();
         reply
     }
@@ -341,9 +354,10 @@ impl Session<'_> {
         what: String,
         mut wait: impl FnMut(&mut LauncherLink, Instant) -> Result<T, ProtocolError>,
     ) -> Result<T, RunError> {
-        let who = self.children.get(role).map_or_else(|| role.name().to_string(), |p| {
-            format!("the {} participant {}", role.name(), p.label())
-        });
+        let who = self.children.get(role).map_or_else(
+            || role.name().to_string(),
+            |p| format!("the {} participant {}", role.name(), p.label()),
+        );
         loop {
             match self.check_alive() {
                 Err(RunError::Died { death, .. }) => {
@@ -360,15 +374,18 @@ impl Session<'_> {
             match wait(link, (now + SLICE).min(deadline)) {
                 Ok(v) => return Ok(v),
                 Err(ProtocolError::Timeout { .. }) => {}
-                Err(ProtocolError::Terminated { signal }) => return Err(RunError::Interrupted(signal)),
+                Err(ProtocolError::Terminated { signal }) => {
+                    return Err(RunError::Interrupted(signal))
+                }
                 Err(e) => return Err(e.into()),
             }
         }
     }
 
-    /// A protocol error right after a child died is explained by the death: report that.
+    /// A wire error (a command that cannot be delivered, a reply that cannot come) right after a
+    /// child died is explained by the death: report that. The launcher's own verdicts stand.
     fn explain(&mut self, e: RunError) -> RunError {
-        if matches!(e, RunError::Died { .. } | RunError::Interrupted(_) | RunError::Case(_)) {
+        if !matches!(e, RunError::Protocol(_)) {
             return e;
         }
         let until = Instant::now() + DEATH_GRACE;
@@ -384,8 +401,7 @@ impl Session<'_> {
     }
 }
 
-/// Writes `run.json`: the common report plus the launcher's view (run id, scheme, overrides,
-/// the structure's energy ledger when present).
+/// Writes `run.json`: the common report plus the launcher's view (run id, scheme, overrides).
 fn write_report(
     out: &OutputDir,
     case: &Case,
@@ -393,7 +409,11 @@ fn write_report(
     run_id: &str,
     status: &str,
     (steps, final_time): (u64, f64),
-    (wall, ipc_wait, solver): (Duration, Duration, &BTreeMap<&'static str, SolverTime>),
+    (wall, launcher, solver): (
+        Duration,
+        [(&str, Duration); 2],
+        &BTreeMap<&'static str, SolverTime>,
+    ),
 ) -> std::io::Result<()> {
     let text = std::fs::read_to_string(&opts.case_file).unwrap_or_default();
     let mut versions = report::versions();
@@ -405,13 +425,10 @@ fn write_report(
             BTreeMap::from([("work".to_string(), t.work_s), ("ipc_wait".to_string(), t.wait_s)]),
         );
     }
-    timings.insert(
-        "launcher".to_string(),
-        BTreeMap::from([
-            ("ipc_wait".to_string(), ipc_wait.as_secs_f64()),
-            ("total".to_string(), wall.as_secs_f64()),
-        ]),
-    );
+    let mut own: BTreeMap<String, f64> =
+        launcher.iter().map(|(name, d)| (name.to_string(), d.as_secs_f64())).collect();
+    own.insert("total".to_string(), wall.as_secs_f64());
+    timings.insert("launcher".to_string(), own);
     let report = RunReport {
         case_file: opts.case_file.display().to_string(),
         case: case_echo(&text).unwrap_or(serde_json::Value::Null),
@@ -423,7 +440,6 @@ fn write_report(
         wall_seconds: wall.as_secs_f64(),
         timings,
     };
-    let energy = read_json(&out.path().join("energy.json"));
     let full = LauncherReport {
         report: &report,
         run_id,
@@ -431,7 +447,6 @@ fn write_report(
         dt: case.coupling.dt,
         t_end: case.coupling.t_end,
         overrides: &opts.overrides,
-        energy,
     };
     interface_protocol::io::atomic::write_atomic(&out.run_json(), |w| {
         serde_json::to_writer_pretty(&mut *w, &full).map_err(std::io::Error::other)?;
@@ -439,6 +454,55 @@ fn write_report(
     })
 }
 
-fn read_json(path: &Path) -> Option<serde_json::Value> {
-    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn generated_run_ids_are_valid_and_distinct() {
+        let a = new_run_id();
+        std::thread::sleep(Duration::from_millis(1));
+        let b = new_run_id();
+        assert_ne!(a, b);
+        for id in [a, b] {
+            interface_protocol::services::validate_run_id(&id).unwrap();
+        }
+    }
+
+    #[test]
+    fn a_death_says_what_the_launcher_was_waiting_for() {
+        let death = Death {
+            role: Role::Structure,
+            label: "rigid-structure (structure, pid 7)".into(),
+            how: "exited with code 1".into(),
+        };
+        let e = RunError::Died {
+            death,
+            waiting: Some("the fluid participant piston-fluid to answer Init".into()),
+        };
+        assert_eq!(
+            e.to_string(),
+            "the structure participant rigid-structure (structure, pid 7) exited with code 1 before \
+             the run finished, while waiting for the fluid participant piston-fluid to answer Init"
+        );
+        assert_eq!(e.exit_code(), 1);
+        assert_eq!(RunError::Interrupted(libc::SIGINT).exit_code(), 130);
+    }
+
+    #[test]
+    fn bad_cases_fail_before_anything_is_created() {
+        let dir = tempfile::tempdir().unwrap();
+        let case = dir.path().join("case.toml");
+        std::fs::write(&case, "[coupling]\ndt = 0\n").unwrap();
+        let out = dir.path().join("out");
+        let opts = RunOptions { case_file: case, out: Some(out.clone()), ..RunOptions::default() };
+        let e = run(&opts).unwrap_err().to_string();
+        assert!(e.contains("case.toml:2:") && e.contains("coupling.dt"), "{e}");
+        assert!(!out.exists());
+        let opts = RunOptions { run_id: Some("bad_id".into()), ..opts };
+        std::fs::write(&opts.case_file, "[coupling]\ndt = 1e-3\n").unwrap();
+        let e = run(&opts).unwrap_err().to_string();
+        assert!(e.contains("invalid run id"), "{e}");
+        assert!(!out.exists());
+    }
 }

@@ -1,7 +1,7 @@
 //! The staggered coupling schemes as a pure state machine: which participant gets which command
 //! next, and whether its reply lets the run go on (DESIGN §4, the agreed command sequence).
 //!
-//! No IO here: the driver sends what [`Sequencer::next`] yields and hands the reply to
+//! No IO here: the driver sends what [`Sequencer::next_command`] yields and hands the reply to
 //! [`Sequencer::accept`]. The sequence, for Δt = `coupling.dt`, t^n = n Δt (the last step
 //! shortened to end at `t_end`), roles S (structure) and F (fluid):
 //!
@@ -149,7 +149,7 @@ impl Sequencer {
 
     /// The next command and its addressee, `None` once the run is over. Call `accept` with the
     /// reply before asking again; asking again without it yields the same command.
-    pub fn next(&mut self) -> Option<(Role, Command)> {
+    pub fn next_command(&mut self) -> Option<(Role, Command)> {
         if let Some(p) = self.pending {
             return Some(p);
         }
@@ -195,7 +195,8 @@ impl Sequencer {
                 expected: format!("{} from {}", cmd.describe(), role.name()),
             });
         }
-        let expected = if cmd.kind == command_kind::INIT { reply_kind::READY } else { reply_kind::DONE };
+        let expected =
+            if cmd.kind == command_kind::INIT { reply_kind::READY } else { reply_kind::DONE };
         if reply.kind == reply_kind::FAILED {
             return Err(SchemeError::Failed {
                 role: role.name(),
@@ -274,9 +275,10 @@ mod tests {
     fn run(s: SchemeSettings) -> Vec<(Role, Command)> {
         let mut seq = Sequencer::new(s).unwrap();
         let mut out = Vec::new();
-        while let Some((role, cmd)) = seq.next() {
+        while let Some((role, cmd)) = seq.next_command() {
             out.push((role, cmd));
-            let kind = if cmd.kind == command_kind::INIT { reply_kind::READY } else { reply_kind::DONE };
+            let kind =
+                if cmd.kind == command_kind::INIT { reply_kind::READY } else { reply_kind::DONE };
             seq.accept(role, &reply(kind)).unwrap();
             assert!(out.len() < 10_000, "the sequence does not end");
         }
@@ -310,7 +312,12 @@ mod tests {
         let got = run(s);
         for (i, ((role, c), line)) in got.iter().zip(&expected).enumerate() {
             let f: Vec<&str> = line.split_whitespace().collect();
-            let here = format!("{name} command {} (`{line}`), got {} {}", i + 1, role.name(), c.describe());
+            let here = format!(
+                "{name} command {} (`{line}`), got {} {}",
+                i + 1,
+                role.name(),
+                c.describe()
+            );
             assert!(f.len() == 6 || f.len() == 7, "{here}: malformed line");
             let role_code = if *role == Role::Structure { "S" } else { "F" };
             assert_eq!(role_code, f[0], "{here}: role");
@@ -347,8 +354,9 @@ mod tests {
     fn steps_are_reported_once_each_with_their_end_time() {
         let mut seq = Sequencer::new(settings(Scheme::A6, 0.1, 0.25, 0)).unwrap();
         let mut done = Vec::new();
-        while let Some((role, cmd)) = seq.next() {
-            let kind = if cmd.kind == command_kind::INIT { reply_kind::READY } else { reply_kind::DONE };
+        while let Some((role, cmd)) = seq.next_command() {
+            let kind =
+                if cmd.kind == command_kind::INIT { reply_kind::READY } else { reply_kind::DONE };
             match seq.accept(role, &reply(kind)).unwrap() {
                 Progress::StepDone { step, t } => done.push((step, t)),
                 Progress::Finished => done.push((99, -1.0)),
@@ -365,20 +373,23 @@ mod tests {
     #[test]
     fn a_failed_reply_stops_the_sequence_with_its_message() {
         let mut seq = Sequencer::new(settings(Scheme::C0, 0.1, 0.3, 0)).unwrap();
-        let (role, _) = seq.next().unwrap();
+        let (role, _) = seq.next_command().unwrap();
         let failed = Reply::failed(7, "mesh file missing");
         let e = seq.accept(role, &failed).unwrap_err().to_string();
-        assert!(e.contains("structure") && e.contains("Init") && e.contains("mesh file missing"), "{e}");
+        assert!(
+            e.contains("structure") && e.contains("Init") && e.contains("mesh file missing"),
+            "{e}"
+        );
         assert!(e.contains("code 7"), "{e}");
         // The same command is still pending.
-        assert_eq!(seq.next().unwrap().1.kind, command_kind::INIT);
-        assert_eq!(seq.next().unwrap().0, Role::Structure);
+        assert_eq!(seq.next_command().unwrap().1.kind, command_kind::INIT);
+        assert_eq!(seq.next_command().unwrap().0, Role::Structure);
     }
 
     #[test]
     fn replies_of_the_wrong_kind_or_role_are_errors() {
         let mut seq = Sequencer::new(settings(Scheme::Css, 0.1, 0.3, 0)).unwrap();
-        seq.next();
+        seq.next_command();
         let e = seq.accept(Role::Structure, &reply(reply_kind::DONE)).unwrap_err();
         assert!(matches!(e, SchemeError::Unexpected { expected: "Ready", .. }), "{e}");
         let e = seq.accept(Role::Fluid, &reply(reply_kind::READY)).unwrap_err();

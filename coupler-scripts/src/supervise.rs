@@ -101,7 +101,8 @@ impl Participant {
         // `getppid`, both async-signal-safe; it allocates nothing and touches no lock.
         unsafe {
             cmd.pre_exec(move || {
-                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM as libc::c_ulong, 0, 0, 0) != 0 {
+                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM as libc::c_ulong, 0, 0, 0) != 0
+                {
                     return Err(std::io::Error::last_os_error());
                 }
                 // The launcher died between fork and prctl: the signal would never come.
@@ -298,7 +299,10 @@ mod tests {
         ps.push(Participant::spawn(Role::Fluid, &cmd, &args(dir.path(), &sets)).unwrap());
         assert!(ps.wait_all(Instant::now() + Duration::from_secs(5)).is_empty());
         let got = std::fs::read_to_string(&log).unwrap();
-        let want = format!("run\ncase.toml\n--couple\nt1\n--out\n{}\n--set\ncoupling.dt=1e-3\n", dir.path().display());
+        let want = format!(
+            "run\ncase.toml\n--couple\nt1\n--out\n{}\n--set\ncoupling.dt=1e-3\n",
+            dir.path().display()
+        );
         assert_eq!(got, want);
         assert_eq!(ps.exits()[0].2.code(), Some(0));
     }
@@ -341,7 +345,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         // The shell ignores SIGTERM, so only SIGKILL after the grace ends it; its `sleep` child
         // goes with the group.
-        let cmd = vec!["sh".into(), "-c".into(), "trap '' TERM; sleep 30; sleep 30".into(), "sh".into()];
+        let cmd =
+            vec!["sh".into(), "-c".into(), "trap '' TERM; sleep 30; sleep 30".into(), "sh".into()];
         let mut ps = Participants::default();
         ps.push(Participant::spawn(Role::Fluid, &cmd, &args(dir.path(), &[])).unwrap());
         let pid = ps.get(Role::Fluid).unwrap().pid() as i32;

@@ -180,16 +180,19 @@ fn toro_on(shape: BoxCells, reference: &str) {
 }
 
 #[test]
+#[cfg_attr(debug_assertions, ignore = "heavy: run with --release")]
 fn toro_shock_tubes_converge_on_hexes() {
     toro_on(BoxCells::Hex, "toro_shock_tubes_hex.json");
 }
 
 #[test]
+#[cfg_attr(debug_assertions, ignore = "heavy: run with --release")]
 fn toro_shock_tubes_converge_on_tets() {
     toro_on(BoxCells::Tet, "toro_shock_tubes_tet.json");
 }
 
 #[test]
+#[cfg_attr(debug_assertions, ignore = "heavy: run with --release")]
 fn liquid_shock_tubes_match_the_exact_solver() {
     let mut table = serde_json::Map::new();
     for tube in liquids() {

@@ -283,6 +283,7 @@ mod tests {
         let e: Vec<f64> =
             [100, 200, 400].iter().map(|&n| (run(scheme, n) - exact(T)).abs()).collect();
         let orders = [(e[0] / e[1]).log2(), (e[1] / e[2]).log2()];
+        eprintln!("{scheme:?}: errors {e:?}, observed orders {orders:?}");
         assert!((orders[0] - orders[1]).abs() < 0.2, "{scheme:?}: errors {e:?}, orders {orders:?}");
         orders[1]
     }

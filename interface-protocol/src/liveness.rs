@@ -99,16 +99,21 @@ impl Watch {
 
     /// `Err` once a termination signal arrived or the launcher is gone.
     pub fn check(&self) -> Result<(), Stop> {
-        if let Some(s) = termination_signal() {
-            return Err(Stop::Signal(s));
-        }
         if let Some(pid) = self.launcher {
             // SAFETY: `getppid` has no preconditions; `kill(pid, 0)` only checks existence.
-            let (parent, alive) = unsafe { (libc::getppid(), libc::kill(pid, 0) == 0) };
+            let (parent, found) = unsafe { (libc::getppid(), libc::kill(pid, 0) == 0) };
+            // EPERM: the process exists but belongs to someone else.
+            let alive =
+                found || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM);
             let reparented = self.launcher_is_parent && parent != pid;
             if reparented || !alive {
                 return Err(Stop::LauncherGone(pid));
             }
+        }
+        // After the launcher: its death also arrives as SIGTERM (parent-death signal), and the
+        // message should say which.
+        if let Some(s) = termination_signal() {
+            return Err(Stop::Signal(s));
         }
         Ok(())
     }
@@ -160,11 +165,18 @@ mod tests {
                 std::fs::write(&out, e.to_string()).unwrap();
                 std::process::exit(3);
             }
+            "stale" => {
+                let s = StructureEndpoint::open(&run_id, HelloInfo::default(), Timeouts::default())
+                    .unwrap();
+                std::fs::write(&out, "open").unwrap();
+                std::thread::sleep(Duration::from_secs(30));
+                drop(s);
+            }
             "launcher" => {
                 let mut c = reexec("participant", &run_id, Path::new(&out));
                 c.env(super::LAUNCHER_PID_ENV, std::process::id().to_string());
-                let _child = c.spawn().unwrap();
-                std::thread::sleep(Duration::from_secs(60));
+                // Killed by the test while it waits for its participant.
+                let _ = c.spawn().unwrap().wait();
             }
             _ => {}
         }
@@ -225,6 +237,24 @@ mod tests {
         assert!(text == "stopped by SIGTERM" || text.contains("launcher"), "{text}");
         assert!(took < Duration::from_secs(1), "took {took:?}");
         link.remove_resources().unwrap();
+        assert!(shm::run_files(&run_id).is_empty());
+        let _ = std::fs::remove_file(&out);
+    }
+
+    #[test]
+    fn files_of_a_run_whose_nodes_died_are_removed_as_stale() {
+        let run_id = format!("t{}-stale", std::process::id());
+        let out = std::env::temp_dir().join(format!("fsi-{run_id}.txt"));
+        let _ = std::fs::remove_file(&out);
+        let mut child = reexec("stale", &run_id, &out).spawn().unwrap();
+        outcome(&out, Instant::now());
+        assert!(shm::run_has_live_node(&run_id));
+        kill(&child, libc::SIGKILL);
+        child.wait().unwrap();
+        assert!(!shm::run_files(&run_id).is_empty(), "a killed node leaves its files");
+        assert!(!shm::run_has_live_node(&run_id));
+        // (A launcher opened by a concurrent test may have cleaned it already: either way it goes.)
+        shm::cleanup_stale_runs();
         assert!(shm::run_files(&run_id).is_empty());
         let _ = std::fs::remove_file(&out);
     }

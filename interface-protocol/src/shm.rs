@@ -27,6 +27,8 @@ pub fn free_bytes(dir: &Path) -> Result<u64, ProtocolError> {
             std::io::Error::last_os_error()
         )));
     }
+    // The field types differ between platforms (u32 on some 32-bit targets).
+    #[allow(clippy::unnecessary_cast)]
     Ok(st.f_bavail as u64 * st.f_frsize as u64)
 }
 

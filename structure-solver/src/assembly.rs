@@ -57,7 +57,11 @@ pub enum Part {
     Shell(ShellSection),
     /// A beam whose local `y` axis is `up` projected normal to it.
     Beam(BeamSection, [f64; 3]),
-    Solid { e: f64, nu: f64, rho: f64 },
+    Solid {
+        e: f64,
+        nu: f64,
+        rho: f64,
+    },
 }
 
 /// Rotary inertia of shells: physical (`ρh³/12` per area; frequency tests and implicit runs)
@@ -120,12 +124,22 @@ impl FeModel {
             let p = gather(&x0, &cell.nodes);
             let nd = &cell.nodes;
             let el = match (cell.kind, part(ci)) {
-                (CellKind::Quad4, Part::Shell(s)) => Element::quad4([nd[0], nd[1], nd[2], nd[3]], &[p[0], p[1], p[2], p[3]], &s),
-                (CellKind::Tri3, Part::Shell(s)) => Element::tri3([nd[0], nd[1], nd[2]], &[p[0], p[1], p[2]], &s),
-                (CellKind::Line2, Part::Beam(s, up)) => Element::beam2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s),
-                (CellKind::Tet4, Part::Solid { e, nu, rho }) => {
-                    Element::tet4([nd[0], nd[1], nd[2], nd[3]], &[p[0], p[1], p[2], p[3]], e, nu, rho)
+                (CellKind::Quad4, Part::Shell(s)) => {
+                    Element::quad4([nd[0], nd[1], nd[2], nd[3]], &[p[0], p[1], p[2], p[3]], &s)
                 }
+                (CellKind::Tri3, Part::Shell(s)) => {
+                    Element::tri3([nd[0], nd[1], nd[2]], &[p[0], p[1], p[2]], &s)
+                }
+                (CellKind::Line2, Part::Beam(s, up)) => {
+                    Element::beam2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s)
+                }
+                (CellKind::Tet4, Part::Solid { e, nu, rho }) => Element::tet4(
+                    [nd[0], nd[1], nd[2], nd[3]],
+                    &[p[0], p[1], p[2], p[3]],
+                    e,
+                    nu,
+                    rho,
+                ),
                 (kind, p) => {
                     let part = match p {
                         Part::Shell(_) => "a shell section",
@@ -145,7 +159,11 @@ impl FeModel {
                 constrained[6 * n..6 * n + k].fill(false);
             }
         }
-        let state = State { x: x0.clone(), r: vec![Matrix3::identity(); nn], spin_sum: vec![Vector3::zeros(); nn] };
+        let state = State {
+            x: x0.clone(),
+            r: vec![Matrix3::identity(); nn],
+            spin_sum: vec![Vector3::zeros(); nn],
+        };
         let mut m = FeModel {
             x0,
             trial: state.clone(),
@@ -174,7 +192,9 @@ impl FeModel {
     /// carry the element's translational mass).
     fn element_mass(&self, e: &Element) -> Vec<f64> {
         let mut m = e.mass.clone();
-        if self.rotary == RotaryInertia::Scaled && matches!(e.kind, ElementKind::Quad4 | ElementKind::Tri3) {
+        if self.rotary == RotaryInertia::Scaled
+            && matches!(e.kind, ElementKind::Quad4 | ElementKind::Tri3)
+        {
             for i in 0..e.nodes.len() {
                 let scaled = m[6 * i] * e.measure / 12.0;
                 for c in 3..6 {
@@ -376,7 +396,7 @@ impl Model for FeModel {
             }
         }
         let pe = self.element_pressure(t);
-        let mut fe = vec![0.0; 24];
+        let mut fe = [0.0; 24];
         for (ei, e) in self.elements.iter().enumerate() {
             if pe[ei] != 0.0 {
                 let k = e.nodes.len();

@@ -8,11 +8,13 @@
 #![deny(unsafe_op_in_unsafe_fn)]
 
 pub mod assembly;
+pub mod bench;
 pub mod elements;
 pub mod explicit_shell;
 pub mod material;
 pub mod mesh;
 pub mod modal;
 pub mod model;
+pub mod run;
 pub mod statics;
 pub mod time;

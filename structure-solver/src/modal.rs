@@ -28,7 +28,8 @@ pub fn lowest_frequencies(model: &mut dyn Model, n: usize) -> Result<Vec<f64>, M
             nf += 1;
         }
     }
-    let mass: Vec<f64> = (0..cons.len()).filter(|&d| !cons[d]).map(|d| model.lumped_mass()[d]).collect();
+    let mass: Vec<f64> =
+        (0..cons.len()).filter(|&d| !cons[d]).map(|d| model.lumped_mass()[d]).collect();
     let mut trip = Vec::new();
     model.tangent(0.0, &mut trip);
     let free: Vec<Triplet<usize, usize, f64>> = trip
@@ -39,12 +40,14 @@ pub fn lowest_frequencies(model: &mut dyn Model, n: usize) -> Result<Vec<f64>, M
             [Triplet::new(i, j, 0.5 * e.val), Triplet::new(j, i, 0.5 * e.val)]
         })
         .collect();
-    let k = SparseColMat::<usize, f64>::try_new_from_triplets(nf, nf, &free).map_err(|e| ModalError::Singular(format!("{e:?}")))?;
+    let k = SparseColMat::<usize, f64>::try_new_from_triplets(nf, nf, &free)
+        .map_err(|e| ModalError::Singular(format!("{e:?}")))?;
     let lu = k.sp_lu().map_err(|e| ModalError::Singular(format!("{e:?}")))?;
     let p = (2 * n).max(n + 8).min(nf);
     // deterministic start vectors
     let mut x = Mat::from_fn(nf, p, |i, j| {
-        let h = ((i as u64 + 1).wrapping_mul(2654435761) ^ (j as u64 + 7).wrapping_mul(40503)) % 1000;
+        let h =
+            ((i as u64 + 1).wrapping_mul(2654435761) ^ (j as u64 + 7).wrapping_mul(40503)) % 1000;
         h as f64 / 1000.0 - 0.5 + if i % p == j { 1.0 } else { 0.0 }
     });
     let mut last = vec![0.0; n];
@@ -54,11 +57,15 @@ pub fn lowest_frequencies(model: &mut dyn Model, n: usize) -> Result<Vec<f64>, M
         let mx = y.clone();
         lu.solve_in_place(y.as_mut());
         // K_r = Yᵀ K Y = Yᵀ M X, M_r = Yᵀ M Y
-        let kr = DMatrix::from_fn(p, p, |a, b| (0..nf).map(|i| y[(i, a)] * mx[(i, b)]).sum::<f64>());
-        let mr = DMatrix::from_fn(p, p, |a, b| (0..nf).map(|i| y[(i, a)] * mass[i] * y[(i, b)]).sum::<f64>());
+        let kr =
+            DMatrix::from_fn(p, p, |a, b| (0..nf).map(|i| y[(i, a)] * mx[(i, b)]).sum::<f64>());
+        let mr = DMatrix::from_fn(p, p, |a, b| {
+            (0..nf).map(|i| y[(i, a)] * mass[i] * y[(i, b)]).sum::<f64>()
+        });
         let kr = 0.5 * (&kr + kr.transpose());
         let mr = 0.5 * (&mr + mr.transpose());
-        let l = mr.clone().cholesky().ok_or_else(|| ModalError::Singular("subspace mass".into()))?.l();
+        let l =
+            mr.clone().cholesky().ok_or_else(|| ModalError::Singular("subspace mass".into()))?.l();
         let linv = l.try_inverse().ok_or_else(|| ModalError::Singular("subspace mass".into()))?;
         let s = &linv * kr * linv.transpose();
         let eig = s.symmetric_eigen();

@@ -85,7 +85,8 @@ impl FreeDofs {
             })
             .collect();
         let err = |e: &dyn std::fmt::Debug| StaticsError::Singular(format!("{e:?}"));
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free).map_err(|e| err(&e))?;
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
+            .map_err(|e| err(&e))?;
         a.sp_lu().map(Factor::Lu).map_err(|e| err(&e))
     }
 
@@ -174,7 +175,12 @@ pub fn load_steps(
                     model.revert();
                     cuts += 1;
                     if cuts > s.max_cuts {
-                        return Err(StaticsError::NoConvergence { from: t_now, to: target, cuts, residual: res });
+                        return Err(StaticsError::NoConvergence {
+                            from: t_now,
+                            to: target,
+                            cuts,
+                            residual: res,
+                        });
                     }
                     h *= 0.5;
                 }
@@ -186,7 +192,13 @@ pub fn load_steps(
 
 /// Newton iterations at load factor `t`; `applied` tracks the constrained dofs' totals
 /// (restored on failure). Returns the relative residual on failure.
-fn newton(model: &mut dyn Model, t: f64, fd: &FreeDofs, applied: &mut [f64], s: &NewtonSettings) -> Result<Converged, f64> {
+fn newton(
+    model: &mut dyn Model,
+    t: f64,
+    fd: &FreeDofs,
+    applied: &mut [f64],
+    s: &NewtonSettings,
+) -> Result<Converged, f64> {
     let n = applied.len();
     let saved = applied.to_vec();
     let mut presc = applied.to_vec();
@@ -285,7 +297,12 @@ pub fn displacement_control(
             uc += du[control];
         }
         if !ok {
-            return Err(StaticsError::NoConvergence { from: uc, to: target, cuts: 0, residual: last });
+            return Err(StaticsError::NoConvergence {
+                from: uc,
+                to: target,
+                cuts: 0,
+                residual: last,
+            });
         }
     }
     Ok(out)

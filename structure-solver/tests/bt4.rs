@@ -29,7 +29,9 @@ fn plate(nx: usize, ny: usize, lx: f64, ly: f64, distort: f64) -> (Vec<[f64; 3]>
     }
     let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
     let conn = (0..ny)
-        .flat_map(|j| (0..nx).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+        .flat_map(|j| {
+            (0..nx).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        })
         .collect();
     (x, conn)
 }
@@ -57,7 +59,9 @@ fn membrane_patch_test_gives_constant_stress_and_no_interior_force() {
     let m = [[1.0 + g[0][0] / 2.0, g[0][1] / 2.0], [g[1][0] / 2.0, 1.0 + g[1][1] / 2.0]];
     let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
     let inv = [[m[1][1] / det, -m[0][1] / det], [-m[1][0] / det, m[0][0] / det]];
-    let l: Vec<Vec<f64>> = (0..2).map(|a| (0..2).map(|b| g[a][0] * inv[0][b] + g[a][1] * inv[1][b]).collect()).collect();
+    let l: Vec<Vec<f64>> = (0..2)
+        .map(|a| (0..2).map(|b| g[a][0] * inv[0][b] + g[a][1] * inv[1][b]).collect())
+        .collect();
     let eps = [l[0][0], l[1][1], l[0][1] + l[1][0]];
     let s_global = mat.elastic.stress_plane_stress(&eps);
     let mut worst: f64 = 0.0;
@@ -255,10 +259,11 @@ fn cantilever_plate_first_bending_frequency_matches_beam_theory() {
 fn plastic_hinge_moment(rule: ThicknessRule) -> (f64, f64) {
     let mat = J2 { elastic: Elastic { e: 200e9, nu: 0.3, rho: 7800.0 }, sigma_y: 250e6, h: 0.0 };
     let (lx, b, h) = (0.1, 0.05, 0.01);
-    let x0 = vec![[0.0, 0.0, 0.0], [lx, 0.0, 0.0], [lx, b, 0.0], [0.0, b, 0.0]];
+    let x0 = [[0.0, 0.0, 0.0], [lx, 0.0, 0.0], [lx, b, 0.0], [0.0, b, 0.0]];
     let np = rule.len();
     let rule_w = rule.clone();
-    let mut bt4 = Bt4::new(vec![[0, 1, 2, 3]], vec![h], mat, Bt4Settings { rule, ..Bt4Settings::default() });
+    let mut bt4 =
+        Bt4::new(vec![[0, 1, 2, 3]], vec![h], mat, Bt4Settings { rule, ..Bt4Settings::default() });
     let kappa_y = 2.0 * mat.sigma_y / (mat.elastic.e * h);
     let steps = 400;
     let dk = 20.0 * kappa_y / steps as f64;
@@ -284,7 +289,8 @@ fn plastic_hinge_moment(rule: ThicknessRule) -> (f64, f64) {
                 du[6 * i + 3] = -kyy * (p[1] - b / 2.0); // θ_x: κ_yy = -Σ b_y θ_x
                 du[6 * i + 1] = eyy * (p[1] - b / 2.0); // u_y: ε_yy
             }
-            let x1: Vec<[f64; 3]> = x0.iter().enumerate().map(|(i, p)| [p[0], p[1] + du[6 * i + 1], p[2]]).collect();
+            let x1: Vec<[f64; 3]> =
+                x0.iter().enumerate().map(|(i, p)| [p[0], p[1] + du[6 * i + 1], p[2]]).collect();
             f.fill(0.0);
             bt4.internal_force(&x1, &du, &mut f);
             // The trial state is what `commit` would accept; read it by committing a copy.
@@ -312,7 +318,11 @@ fn plastic_hinge_moment_matches_the_thickness_rule_and_the_fully_plastic_moment(
     let (m8, ref8) = plastic_hinge_moment(ThicknessRule::gauss(8));
     let mp = 250e6 * 0.05 * 0.01 * 0.01 / 4.0;
     println!("plastic hinge: 5 points M = {m5:.4} N m vs Σ w|ζ| σy b h²/4 = {ref5:.4} ({:+.3}%), M/M_p = {:.4}", 100.0 * (m5 / ref5 - 1.0), m5 / mp);
-    println!("plastic hinge: 8 points M = {m8:.4} N m vs {ref8:.4} ({:+.3}%), M/M_p = {:.4}", 100.0 * (m8 / ref8 - 1.0), m8 / mp);
+    println!(
+        "plastic hinge: 8 points M = {m8:.4} N m vs {ref8:.4} ({:+.3}%), M/M_p = {:.4}",
+        100.0 * (m8 / ref8 - 1.0),
+        m8 / mp
+    );
     assert!((m5 / ref5 - 1.0).abs() < 0.01);
     assert!((m8 / ref8 - 1.0).abs() < 0.01);
     assert!((m8 / mp - 1.0).abs() < 0.02);

@@ -28,7 +28,8 @@ fn cantilever_beam_bending_modes() {
     m.fix(&all, [false, true, false, true, false, true]);
     let got = lowest_frequencies(&mut m, 3).unwrap();
     let c = (e * sec.iy / (rho * sec.area * l.powi(4))).sqrt();
-    let want: Vec<f64> = [1.875104069, 4.694091133, 7.854757438].iter().map(|bl: &f64| bl * bl * c).collect();
+    let want: Vec<f64> =
+        [1.875104069, 4.694091133, 7.854757438].iter().map(|bl: &f64| bl * bl * c).collect();
     compare("cantilever beam", &got, &want);
 }
 
@@ -47,8 +48,16 @@ fn plate(triangles: bool) {
     }
     let got = lowest_frequencies(&mut m, 3).unwrap();
     let d = e * h.powi(3) / (12.0 * (1.0 - nu * nu));
-    let w = |mm: f64, nn: f64| std::f64::consts::PI.powi(2) * ((mm / a).powi(2) + (nn / b).powi(2)) * (d / (rho * h)).sqrt();
-    compare(if triangles { "SS plate triangles" } else { "SS plate quads" }, &got, &[w(1.0, 1.0), w(2.0, 1.0), w(3.0, 1.0)]);
+    let w = |mm: f64, nn: f64| {
+        std::f64::consts::PI.powi(2)
+            * ((mm / a).powi(2) + (nn / b).powi(2))
+            * (d / (rho * h)).sqrt()
+    };
+    compare(
+        if triangles { "SS plate triangles" } else { "SS plate quads" },
+        &got,
+        &[w(1.0, 1.0), w(2.0, 1.0), w(3.0, 1.0)],
+    );
 }
 
 #[test]

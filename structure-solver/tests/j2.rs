@@ -22,7 +22,11 @@ fn elastic_stress_is_the_energy_gradient_and_tangent_the_stress_gradient() {
         ep[i] += h;
         em[i] -= h;
         let fd = (m.energy_3d(&ep) - m.energy_3d(&em)) / (2.0 * h);
-        assert!((fd - s[i]).abs() < 1e-6 * s.iter().map(|v| v.abs()).fold(0.0, f64::max), "3D stress {i}: {fd} vs {}", s[i]);
+        assert!(
+            (fd - s[i]).abs() < 1e-6 * s.iter().map(|v| v.abs()).fold(0.0, f64::max),
+            "3D stress {i}: {fd} vs {}",
+            s[i]
+        );
         let (sp, sm) = (m.stress_3d(&ep), m.stress_3d(&em));
         for j in 0..6 {
             let fd = (sp[j] - sm[j]) / (2.0 * h);
@@ -123,8 +127,11 @@ fn j2_3d_uniaxial_loading_unloading_and_reverse_yield_match_the_closed_form() {
     let mut newton_max = 0;
     let mut worst = [0.0f64; 4];
     for k in 1..=3 * n {
-        let (eps11, loading) =
-            if k <= n { (eps1 * k as f64 / n as f64, true) } else { (eps1 - eps1 * (k - n) as f64 / n as f64, false) };
+        let (eps11, loading) = if k <= n {
+            (eps1 * k as f64 / n as f64, true)
+        } else {
+            (eps1 - eps1 * (k - n) as f64 / n as f64, false)
+        };
         let mut it = 0;
         let (sigma, new) = loop {
             let eps = [eps11, lateral, lateral, 0.0, 0.0, 0.0];
@@ -161,8 +168,11 @@ fn j2_plane_stress_uniaxial_loading_unloading_and_reverse_yield_match_the_closed
     let (n, eps1) = (200, 0.01);
     let mut worst = [0.0f64; 5];
     for k in 1..=3 * n {
-        let (eps11, loading) =
-            if k <= n { (eps1 * k as f64 / n as f64, true) } else { (eps1 - eps1 * (k - n) as f64 / n as f64, false) };
+        let (eps11, loading) = if k <= n {
+            (eps1 * k as f64 / n as f64, true)
+        } else {
+            (eps1 - eps1 * (k - n) as f64 / n as f64, false)
+        };
         let mut it = 0;
         let (sigma, new) = loop {
             let (s, new, c) = m.update_plane_stress(&[eps11, lateral, 0.0], &state);
@@ -184,7 +194,13 @@ fn j2_plane_stress_uniaxial_loading_unloading_and_reverse_yield_match_the_closed
         worst[4] = worst[4].max((thick - lat).abs());
     }
     println!("plane-stress uniaxial: max |Δσ|/σy {:.2e}, |Δεp| {:.2e}, |Δα| {:.2e}, |Δε_yy| {:.2e}, |Δε_zz| {:.2e}", worst[0], worst[1], worst[2], worst[3], worst[4]);
-    assert!(worst[0] < 1e-9 && worst[1] < 1e-12 && worst[2] < 1e-12 && worst[3] < 1e-12 && worst[4] < 1e-12);
+    assert!(
+        worst[0] < 1e-9
+            && worst[1] < 1e-12
+            && worst[2] < 1e-12
+            && worst[3] < 1e-12
+            && worst[4] < 1e-12
+    );
 }
 
 /// The reason shells need the plane-stress return (DESIGN §6): a 3D radial return applied to the
@@ -211,7 +227,11 @@ fn radial_return_on_a_plane_stress_trial_is_wrong_and_the_plane_stress_return_is
     }
     let rel_s = (s_3d[0] - s_ps[0]) / s_ps[0];
     let rel_a = (a_3d - a_ps) / a_ps;
-    println!("3D return on plane-stress trials: stress {:+.2}%, plastic strain {:+.2}%", 100.0 * rel_s, 100.0 * rel_a);
+    println!(
+        "3D return on plane-stress trials: stress {:+.2}%, plastic strain {:+.2}%",
+        100.0 * rel_s,
+        100.0 * rel_a
+    );
     assert!(rel_s.abs() > 1e-3 && rel_a.abs() > 1e-2);
 }
 
@@ -224,7 +244,8 @@ fn plane_stress_return_with_three_newton_updates_is_converged_for_explicit_incre
     for k in 1..=10 {
         let kappa = m.yield_stress(1e-3);
         let dir = [1.0, -0.4 + 0.08 * k as f64, 0.1 * k as f64];
-        let xi = (dir[0] * dir[0] - dir[0] * dir[1] + dir[1] * dir[1] + 3.0 * dir[2] * dir[2]).sqrt();
+        let xi =
+            (dir[0] * dir[0] - dir[0] * dir[1] + dir[1] * dir[1] + 3.0 * dir[2] * dir[2]).sqrt();
         let trial = dir.map(|d| d * kappa / xi * (1.0 + 0.02 * k as f64));
         let exact = m.return_plane_stress(trial, 1e-3, 50, 1e-15);
         let three = m.return_plane_stress(trial, 1e-3, 3, 0.0);

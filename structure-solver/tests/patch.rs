@@ -25,7 +25,12 @@ fn distorted_patch(triangles: bool) -> Mesh {
 }
 
 fn boundary(m: &Mesh) -> Vec<usize> {
-    m.nodes_where(|p| p[0].abs() < 1e-12 || p[1].abs() < 1e-12 || (p[0] - 1.0).abs() < 1e-12 || (p[1] - 1.0).abs() < 1e-12)
+    m.nodes_where(|p| {
+        p[0].abs() < 1e-12
+            || p[1].abs() < 1e-12
+            || (p[0] - 1.0).abs() < 1e-12
+            || (p[1] - 1.0).abs() < 1e-12
+    })
 }
 
 fn solve(model: &mut FeModel) {
@@ -34,7 +39,13 @@ fn solve(model: &mut FeModel) {
 }
 
 /// Prescribes `field(x, y)` (6 dof values) on `nodes` for the dofs in `mask`.
-fn prescribe(model: &mut FeModel, mesh: &Mesh, nodes: &[usize], mask: [bool; 6], field: &dyn Fn(f64, f64) -> [f64; 6]) {
+fn prescribe(
+    model: &mut FeModel,
+    mesh: &Mesh,
+    nodes: &[usize],
+    mask: [bool; 6],
+    field: &dyn Fn(f64, f64) -> [f64; 6],
+) {
     for &n in nodes {
         let p = mesh.nodes[n];
         let v = field(p[0], p[1]);
@@ -55,7 +66,7 @@ fn shell_patch(triangles: bool, bending: bool) {
     // θx = ∂w/∂y, θy = -∂w/∂x
     let field = move |x: f64, y: f64| -> [f64; 6] {
         if bending {
-            let (kx, ky, kxy) = (2.0 * s, -1.0 * s, 1.5 * s);
+            let (kx, ky, kxy) = (2.0 * s, -s, 1.5 * s);
             let w = 0.5 * (kx * x * x + ky * y * y + kxy * x * y);
             [0.0, 0.0, w, ky * y + 0.5 * kxy * x, -(kx * x + 0.5 * kxy * y), 0.0]
         } else {
@@ -89,7 +100,11 @@ fn shell_patch(triangles: bool, bending: bool) {
             worst = worst.max((th[0] - want[3]).abs() / s).max((th[1] - want[4]).abs() / s);
         }
     }
-    let name = format!("{} {}", if triangles { "triangles" } else { "quads" }, if bending { "bending" } else { "membrane" });
+    let name = format!(
+        "{} {}",
+        if triangles { "triangles" } else { "quads" },
+        if bending { "bending" } else { "membrane" }
+    );
     println!("{name}: max interior error / field scale = {worst:.2e}");
     assert!(worst < 1e-6, "{name}: patch error {worst:e}");
 }
@@ -141,13 +156,21 @@ fn tet_patch() -> Mesh {
                     id(i, j + 1, k + 1),
                 ];
                 // 6 tets around the 0-6 diagonal
-                for t in [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]] {
+                for t in [
+                    [0, 1, 2, 6],
+                    [0, 2, 3, 6],
+                    [0, 3, 7, 6],
+                    [0, 7, 4, 6],
+                    [0, 4, 5, 6],
+                    [0, 5, 1, 6],
+                ] {
                     let mut nodes = t.map(|a| c[a]).to_vec();
                     // positive volume
                     let p = |a: usize| m.nodes[nodes[a]];
                     let v = |a: usize, b: usize| [0, 1, 2].map(|q| p(a)[q] - p(b)[q]);
                     let (a, b, cc) = (v(1, 0), v(2, 0), v(3, 0));
-                    let det = a[0] * (b[1] * cc[2] - b[2] * cc[1]) - a[1] * (b[0] * cc[2] - b[2] * cc[0])
+                    let det = a[0] * (b[1] * cc[2] - b[2] * cc[1])
+                        - a[1] * (b[0] * cc[2] - b[2] * cc[0])
                         + a[2] * (b[0] * cc[1] - b[1] * cc[0]);
                     if det < 0.0 {
                         nodes.swap(1, 2);

@@ -15,7 +15,14 @@ fn check(mesh: &Mesh, part: Part, name: &str) {
     let mut du = vec![0.0; 6 * n];
     for i in 0..n {
         let p = mesh.nodes[i];
-        let v = [0.01 * p[0] + 0.004 * p[1], -0.006 * p[0] + 0.008 * p[1], 0.02 * p[0] * p[1] + 0.01 * p[0] * p[0], 0.03 * p[1], -0.02 * p[0], 0.01 * (p[0] - p[1])];
+        let v = [
+            0.01 * p[0] + 0.004 * p[1],
+            -0.006 * p[0] + 0.008 * p[1],
+            0.02 * p[0] * p[1] + 0.01 * p[0] * p[0],
+            0.03 * p[1],
+            -0.02 * p[0],
+            0.01 * (p[0] - p[1]),
+        ];
         du[6 * i..6 * i + 6].copy_from_slice(&v);
     }
     m.apply_increment(&du);
@@ -56,7 +63,10 @@ fn check(mesh: &Mesh, part: Part, name: &str) {
                 df = df.max((qm * v0 - v1).norm());
             }
         }
-        println!("{name}, {deg}°: max |Δd| = {dd:.2e}, max |Q f0 - f1| / |f| = {:.2e}", df / fscale);
+        println!(
+            "{name}, {deg}°: max |Δd| = {dd:.2e}, max |Q f0 - f1| / |f| = {:.2e}",
+            df / fscale
+        );
         assert!(dd < 1e-12, "{name} {deg}: corotated deformation changed by {dd:e}");
         assert!(df / fscale < 1e-9, "{name} {deg}: forces did not rotate ({:e})", df / fscale);
     }
@@ -89,5 +99,9 @@ fn triangle_rotated_rigidly_keeps_its_stress() {
 #[test]
 fn beam_rotated_rigidly_keeps_its_stress() {
     let sec = BeamSection::rectangle(2e11, 0.3, 7850.0, 0.02, 0.01);
-    check(&generate::line([0.0, 0.0, 0.0], [1.0, 0.3, 0.2], 1), Part::Beam(sec, [0.0, 0.0, 1.0]), "beam");
+    check(
+        &generate::line([0.0, 0.0, 0.0], [1.0, 0.3, 0.2], 1),
+        Part::Beam(sec, [0.0, 0.0, 1.0]),
+        "beam",
+    );
 }

@@ -72,5 +72,10 @@ fn quads_16x1_follow_the_reference() {
 
 #[test]
 fn triangles_16x1_follow_the_reference() {
-    check(generate::rectangle(10.0, 1.0, 16, 1).to_triangles(), "cantilever triangles 16x1x2", 0.02, 0.02);
+    check(
+        generate::rectangle(10.0, 1.0, 16, 1).to_triangles(),
+        "cantilever triangles 16x1x2",
+        0.02,
+        0.02,
+    );
 }

@@ -67,8 +67,15 @@ fn check(n: usize, triangles: bool, name: &str, tol_final: [f64; 2], tol_all: f6
     let table = Table { name, columns: &["u_A", "-v_B"], rows: ROWS };
     let errors = run_table(&mut m, &table, |m| vec![displacement(m, a)[0], -displacement(m, b)[1]]);
     let last = errors.last().unwrap();
-    assert!(last[0].abs() < tol_final[0] && last[1].abs() < tol_final[1], "{name}: final errors {last:?}");
-    assert!(common::max_error(&errors) < tol_all, "{name}: max error {}", common::max_error(&errors));
+    assert!(
+        last[0].abs() < tol_final[0] && last[1].abs() < tol_final[1],
+        "{name}: final errors {last:?}"
+    );
+    assert!(
+        common::max_error(&errors) < tol_all,
+        "{name}: max error {}",
+        common::max_error(&errors)
+    );
 }
 
 /// The flat MITC4 facets are stiffer than the paper's S4R on 16x16: u_A -1.9%, -v_B -3.2% at

@@ -4,7 +4,9 @@
 
 use faer::sparse::Triplet;
 use structure_solver::model::Model;
-use structure_solver::time::{critical_dt, kinetic_energy, CentralDifference, Implicit, ImplicitScheme};
+use structure_solver::time::{
+    critical_dt, kinetic_energy, CentralDifference, Implicit, ImplicitScheme,
+};
 
 /// Masses on the x axis joined by springs `k` (+ cubic `k3 δ³`), node 0 tied to the ground by
 /// `k_ground`; only `ux` is free.
@@ -27,7 +29,16 @@ impl Chain {
             mass[6 * i] = m;
             fixed[6 * i] = false;
         }
-        Chain { n, k, k3: 0.0, k_ground, mass, fixed, u: vec![0.0; 6 * n], committed: vec![0.0; 6 * n] }
+        Chain {
+            n,
+            k,
+            k3: 0.0,
+            k_ground,
+            mass,
+            fixed,
+            u: vec![0.0; 6 * n],
+            committed: vec![0.0; 6 * n],
+        }
     }
 
     fn energy(&self) -> f64 {
@@ -75,7 +86,12 @@ impl Model for Chain {
             let d = self.u[6 * i] - self.u[6 * (i - 1)];
             let k = self.k + 3.0 * self.k3 * d * d;
             let (a, b) = (6 * (i - 1), 6 * i);
-            out.extend([Triplet::new(a, a, k), Triplet::new(b, b, k), Triplet::new(a, b, -k), Triplet::new(b, a, -k)]);
+            out.extend([
+                Triplet::new(a, a, k),
+                Triplet::new(b, b, k),
+                Triplet::new(a, b, -k),
+                Triplet::new(b, a, -k),
+            ]);
         }
     }
     fn commit(&mut self) {
@@ -158,7 +174,10 @@ fn newmark_and_midpoint_periods_follow_the_trapezoidal_dispersion() {
             let cos_exact = (1.0 - q) / (1.0 + q);
             let err = dispersion_error(&hist, cos_exact);
             let omega = 2.0 * (dt / 2.0f64).atan() / dt;
-            println!("{scheme:?} dt {dt}: dispersion error {err:.2e}, period error {:.4e}", 1.0 / omega - 1.0);
+            println!(
+                "{scheme:?} dt {dt}: dispersion error {err:.2e}, period error {:.4e}",
+                1.0 / omega - 1.0
+            );
             assert!(err < 1e-10);
             // Amplitude is conserved (no numerical damping).
             let amp = hist.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -183,7 +202,10 @@ fn displacement_error_of_every_integrator_has_observed_order_two() {
             errs.push((hist[steps] - (steps as f64 * dt).cos()).abs());
         }
         let orders: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-        println!("{scheme:?}: errors {:?}, orders {orders:.3?}", errs.iter().map(|e| format!("{e:.3e}")).collect::<Vec<_>>());
+        println!(
+            "{scheme:?}: errors {:?}, orders {orders:.3?}",
+            errs.iter().map(|e| format!("{e:.3e}")).collect::<Vec<_>>()
+        );
         assert!(orders.iter().all(|p| (p - 2.0).abs() < 0.1));
     }
 }
@@ -195,7 +217,8 @@ fn implicit_midpoint_conserves_energy_of_a_linear_chain_to_the_newton_tolerance(
         m.u[6 * i] = 0.1 * ((i * 37 % 11) as f64 - 5.0) / 5.0;
     }
     m.commit();
-    let v0: Vec<f64> = (0..72).map(|d| if d % 6 == 0 { ((d * 13 % 7) as f64 - 3.0) * 0.2 } else { 0.0 }).collect();
+    let v0: Vec<f64> =
+        (0..72).map(|d| if d % 6 == 0 { ((d * 13 % 7) as f64 - 3.0) * 0.2 } else { 0.0 }).collect();
     let mut im = Implicit::new(&mut m, ImplicitScheme::Midpoint, 0.0, v0, None);
     im.params.tol = 1e-12;
     let e0 = m.energy() + kinetic_energy(&m, &im.state.v);
@@ -225,10 +248,14 @@ fn central_difference_is_stable_below_the_estimated_critical_step_and_not_above(
     let mut m = Chain::new(n, 1.0, 100.0, 100.0);
     // Ground spring k at node 0 and n springs: a fixed-free chain of n masses,
     // ω_j = 2 sqrt(k/m) sin((2j-1)π / (2(2n+1))).
-    let w_max = 20.0 * ((2 * n - 1) as f64 * std::f64::consts::PI / (2.0 * (2 * n + 1) as f64)).sin();
+    let w_max =
+        20.0 * ((2 * n - 1) as f64 * std::f64::consts::PI / (2.0 * (2 * n + 1) as f64)).sin();
     let exact = 2.0 / w_max;
     let est = critical_dt(&mut m, 0.0, 400, 1e-6);
-    println!("critical step: exact {exact:.6e}, power {:.6e}, Gershgorin {:.6e}, element {:.6e}", est.power, est.gershgorin, est.element);
+    println!(
+        "critical step: exact {exact:.6e}, power {:.6e}, Gershgorin {:.6e}, element {:.6e}",
+        est.power, est.gershgorin, est.element
+    );
     assert!(est.gershgorin <= exact && est.element <= exact);
     assert!((est.power - exact).abs() / exact < 0.01);
     let run = |dt: f64, steps: usize| {

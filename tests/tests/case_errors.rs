@@ -87,5 +87,9 @@ fn a_missing_case_file_is_an_error_not_a_panic() {
     let done =
         Fsi::start(&scratch, &["check", "/nonexistent/case.toml"]).wait(Duration::from_secs(10));
     assert!(!done.status.success());
-    assert!(done.stderr.contains("/nonexistent/case.toml") && !done.stderr.contains("panicked"), "{}", done.stderr);
+    assert!(
+        done.stderr.contains("/nonexistent/case.toml") && !done.stderr.contains("panicked"),
+        "{}",
+        done.stderr
+    );
 }

@@ -82,7 +82,8 @@ fn errors(scheme: &str, dts: &[f64]) -> Vec<f64> {
     let scratch = Scratch::new();
     dts.iter()
         .map(|&dt| {
-            let case = scratch.case(&format!("{scheme}-{}", (1.0 / dt).round()), &OSC.case(scheme, dt));
+            let case =
+                scratch.case(&format!("{scheme}-{}", (1.0 / dt).round()), &OSC.case(scheme, dt));
             let out = scratch.path().join(format!("out-{}", (1.0 / dt).round()));
             let done = Fsi::run(&scratch, &case, &out, &[]).wait(Duration::from_secs(20));
             assert!(done.status.success(), "fsi run {scheme} dt {dt} failed:\n{}", done.stderr);

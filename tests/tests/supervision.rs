@@ -35,7 +35,13 @@ probe = "piston"
 }
 
 /// A case with the given participant commands (TOML arrays) and timeout.
-fn case_with(scratch: &Scratch, name: &str, fluid: &str, structure: &str, timeout_s: f64) -> PathBuf {
+fn case_with(
+    scratch: &Scratch,
+    name: &str,
+    fluid: &str,
+    structure: &str,
+    timeout_s: f64,
+) -> PathBuf {
     let text = format!(
         r#"[coupling]
 scheme = "A6"
@@ -74,9 +80,10 @@ fn running(fsi: &Fsi, out: &Path) -> Vec<(i32, String)> {
 }
 
 fn pid_of(kids: &[(i32, String)], name: &str) -> i32 {
-    kids.iter().find(|(_, n)| name.starts_with(n.as_str())).map(|k| k.0).unwrap_or_else(|| {
-        panic!("no participant named {name} among {kids:?}")
-    })
+    kids.iter()
+        .find(|(_, n)| name.starts_with(n.as_str()))
+        .map(|k| k.0)
+        .unwrap_or_else(|| panic!("no participant named {name} among {kids:?}"))
 }
 
 fn assert_failed_naming(done: &Finished, words: &[&str]) {
@@ -137,7 +144,8 @@ fn killing_fsi_ends_both_participants_within_a_second() {
     // Nobody is left to remove the run's files: the next launcher removes stale runs; here the
     // test does, so nothing accumulates.
     let _ = interface_protocol::shm::cleanup_run(&run_id);
-    let gone = gone.unwrap_or_else(|| panic!("participants {kids:?} still alive 5 s after fsi died"));
+    let gone =
+        gone.unwrap_or_else(|| panic!("participants {kids:?} still alive 5 s after fsi died"));
     println!("fsi killed: participants gone {gone:?} later");
     assert!(gone < Duration::from_secs(1), "participants took {gone:?} to exit");
 }
@@ -167,7 +175,7 @@ fn sigterm_to_fsi_stops_both_participants_cleanly() {
 #[test]
 fn a_protocol_version_mismatch_is_refused_naming_both_versions() {
     let scratch = Scratch::new();
-    let stub = r#"["hello-stub", "--role", "structure", "--protocol-version", "99"]"#;
+    let stub = r#"["fake-participant", "--role", "structure", "--protocol-version", "99"]"#;
     let case = case_with(&scratch, "version", r#"["piston-fluid"]"#, stub, 5.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
@@ -182,7 +190,7 @@ fn a_protocol_version_mismatch_is_refused_naming_both_versions() {
 #[test]
 fn a_node_count_mismatch_is_refused_naming_both_counts() {
     let scratch = Scratch::new();
-    let stub = r#"["hello-stub", "--role", "fluid", "--nodes", "5"]"#;
+    let stub = r#"["fake-participant", "--role", "fluid", "--nodes", "5"]"#;
     let case = case_with(&scratch, "nodes", stub, r#"["rigid-structure"]"#, 5.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
@@ -205,7 +213,9 @@ fn a_participant_that_never_sends_hello_is_named_after_the_timeout() {
     let run_id = fsi.run_id.clone();
     let done = fsi.wait(Duration::from_secs(10));
     println!("no hello after {:?}: {}", done.elapsed, done.stderr.trim());
-    assert_failed_naming(&done, &["silent-solver", "structure", "Hello", "1.5 s"]);
+    // Either the launcher's wait for the Hello runs out first, or the fluid's wait for its first
+    // command does and the launcher says what it was waiting for: both name the silent solver.
+    assert_failed_naming(&done, &["silent-solver", "structure", "Hello"]);
     let limit = Duration::from_secs_f64(1.5 + 2.0);
     assert!(done.elapsed < limit, "took {:?}", done.elapsed);
     assert_no_run_files(&run_id);
@@ -214,7 +224,8 @@ fn a_participant_that_never_sends_hello_is_named_after_the_timeout() {
 #[test]
 fn a_missing_participant_binary_is_named_at_once() {
     let scratch = Scratch::new();
-    let case = case_with(&scratch, "missing", r#"["no-such-solver-xyz"]"#, r#"["rigid-structure"]"#, 5.0);
+    let case =
+        case_with(&scratch, "missing", r#"["no-such-solver-xyz"]"#, r#"["rigid-structure"]"#, 5.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
@@ -248,6 +259,23 @@ fn a_participant_that_stops_answering_ends_the_run_after_the_timeout() {
     for (pid, name) in &kids {
         assert!(!alive(*pid), "{name} (pid {pid}) survived");
     }
+    assert_no_run_files(&run_id);
+}
+
+#[test]
+fn a_failed_reply_finishes_the_other_participant_and_reports_the_message() {
+    let scratch = Scratch::new();
+    let fluid = r#"["fake-participant", "--role", "fluid", "--fail-init", "mesh file cylinder.msh missing"]"#;
+    let case = case_with(&scratch, "failed", fluid, r#"["rigid-structure"]"#, 5.0);
+    let out = scratch.path().join("out");
+    let fsi = Fsi::run(&scratch, &case, &out, &[]);
+    let run_id = fsi.run_id.clone();
+    let done = fsi.wait(Duration::from_secs(10));
+    println!("failed init after {:?}: {}", done.elapsed, done.stderr.trim());
+    assert_failed_naming(&done, &["fluid failed at Init", "mesh file cylinder.msh missing"]);
+    assert!(done.elapsed < Duration::from_secs(4), "took {:?}", done.elapsed);
+    // The structure was told to finish, and did: it reports no error of its own.
+    assert!(!done.stderr.contains("rigid-structure:"), "{}", done.stderr);
     assert_no_run_files(&run_id);
 }
 

@@ -5,9 +5,10 @@ use super::{flux_of, roe_average, unit, RoeAverage};
 use crate::eos::Eos;
 
 /// Harten's entropy-fix coefficient ε: an acoustic eigenvalue `λ` with `|λ| < δ`,
-/// `δ = ε (|ũ_n| + c̃)`, is replaced by `(λ² + δ²) / (2δ)` (Harten & Hyman, J. Comput. Phys. 50,
-/// 1983), which removes expansion shocks at sonic points. Contact and shear waves are not fixed,
-/// so a stationary contact stays sharp.
+/// `δ = ε (|ũ_n| + c̃)`, is replaced by `(λ² + δ²) / (2δ)` (Harten, J. Comput. Phys. 49, 1983),
+/// which removes expansion shocks at sonic points (checked by the test
+/// `sonic_rarefaction_has_no_expansion_shock`). Contact and shear waves are not fixed, so a
+/// stationary contact stays sharp.
 pub const ENTROPY_FIX: f64 = 0.1;
 
 /// Roe flux `½(f(W_l) + f(W_r))·n - ½ |Ã| (Q_r - Q_l) |n|`.
@@ -41,8 +42,9 @@ pub fn roe(eos: &Eos, wl: &[f64; 5], wr: &[f64; 5], n: &[f64; 3]) -> [f64; 5] {
 /// The acoustic waves `λ = ũ_n ∓ c̃`, `r = (1, ũ ∓ c̃ n̂, H̃ ∓ ũ_n c̃)`,
 /// `α = (Δp ∓ ρ̃ c̃ Δu_n) / (2 c̃²)` are the same for all three EOS; every other wave (contact,
 /// shear, and for Tait the decoupled energy) moves at `ũ_n`, so their sum is
-/// `ΔQ - α₁ r₁ - α₅ r₅` whatever its split: `φ(Ã)ΔQ = φ(ũ_n) ΔQ + Σ_{acoustic} (φ(λ) - φ(ũ_n)) α r`.
-/// `phi(λ, acoustic)`.
+/// `ΔQ - α₁ r₁ - α₅ r₅` whatever its split:
+/// `φ(Ã)ΔQ = φ(ũ_n) ΔQ + Σ_{acoustic} (φ(λ) - φ(ũ_n)) α r`.
+/// `phi(λ, acoustic)` is told whether `λ` belongs to an acoustic wave.
 #[inline(always)]
 pub(super) fn apply_roe_matrix(
     avg: &RoeAverage,

@@ -54,7 +54,7 @@ impl BoxSpec {
     /// Builds the raw mesh.
     pub fn raw(&self) -> Result<RawMesh, MeshError> {
         for d in 0..3 {
-            if self.cells[d] == 0 || !(self.hi[d] > self.lo[d]) {
+            if self.cells[d] == 0 || self.hi[d].partial_cmp(&self.lo[d]).is_none_or(|o| o.is_le()) {
                 return Err(MeshError::Input(format!(
                     "box mesh: axis {d} needs at least one cell and hi > lo (cells {}, lo {}, hi {})",
                     self.cells[d], self.lo[d], self.hi[d]

@@ -170,7 +170,8 @@ pub(super) fn build(mut raw: RawMesh) -> Result<Mesh, MeshError> {
             }
         }
         let size = (0..cell.kind.n_nodes()).map(|l| norm(sub(x(l), g))).fold(0.0, f64::max);
-        if !(cell_volume > 1e-12 * size * size * size) {
+        // Also catches NaN coordinates.
+        if cell_volume.partial_cmp(&(1e-12 * size * size * size)).is_none_or(|o| o.is_le()) {
             return Err(MeshError::BadCell {
                 origin: raw.origin.clone(),
                 cell: k,

@@ -32,7 +32,7 @@ fn invert_sym3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
     let det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
     let trace = m[0][0] + m[1][1] + m[2][2];
-    if !(det.abs() > 1e-10 * trace * trace * trace) {
+    if det.abs().partial_cmp(&(1e-10 * trace * trace * trace)).is_none_or(|o| o.is_le()) {
         return None;
     }
     let inv = 1.0 / det;

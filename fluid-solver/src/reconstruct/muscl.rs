@@ -1,5 +1,5 @@
 //! Edge-based MUSCL extrapolation of primitive variables to the edge midpoint (thesis §3.3.1,
-//! ref. [84]; the vertex-centred form of Dervieux and Farhat): for an edge `i -> j` with
+//! thesis ref. 84; the vertex-centred form of Dervieux and Farhat): for an edge `i -> j` with
 //! `d = x_j - x_i`, `u_ij = u_i + L(2∇u_i·d - Δ, Δ)/2` and `u_ji = u_j - L(2∇u_j·d - Δ, Δ)/2`,
 //! `Δ = u_j - u_i`, with the slope `L` of the chosen [`Limiter`].
 

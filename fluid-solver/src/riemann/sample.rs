@@ -33,6 +33,15 @@ impl RiemannSolution {
         Ok(RiemannSolution { left, right, star })
     }
 
+    /// The full solution of the one-sided problem of
+    /// [`fluid_structure`](super::fluid_structure()) (fluid `s` left of a wall moving at `w_n`,
+    /// lab frame): App. A's mirror image, the state `(ρ, 2w_n - u, p)` on the right, makes the
+    /// contact move with the wall; sample it only at `ξ <= w_n`. For fluid right of a wall, mirror
+    /// the axis (`u -> -u`, `w_n -> -w_n`, `ξ -> -ξ`).
+    pub fn wall(eos: &Eos, s: State1d, w_n: f64) -> Result<Self, RiemannError> {
+        RiemannSolution::new(eos, s, eos, State1d { u: 2.0 * w_n - s.u, ..s })
+    }
+
     /// Speeds `(head, tail)` of the left wave (equal for a shock).
     pub fn left_wave(&self) -> (f64, f64) {
         wave_speeds(&self.left, &self.star, self.star.rho_l, -1.0)

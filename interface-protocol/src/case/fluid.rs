@@ -6,12 +6,14 @@
 //! with the same `fluid.<field>` names in its errors.
 //!
 //! ```toml
-//! [fluid.mesh]
-//! box = { lo = [0, 0, 0], hi = [1, 0.01, 0.01], cells = [100, 1, 1], shape = "hex" }
-//! # or: file = "mesh.msh"  (gmsh 4.1, physical groups name the boundaries)
-//!
 //! [fluid]
 //! eos = { kind = "perfect_gas", gamma = 1.4 }
+//! probes = [{ name = "p1", at = [0.2, 0, 0] }]
+//! lines = [{ name = "axis", from = [0, 0, 0], to = [1, 0, 0], points = 201, times = [0.1] }]
+//!
+//! [fluid.mesh]
+//! box = { lo = [0, 0, 0], hi = [1, 0.04, 0.04], cells = [100, 1, 1], shape = "hex" }
+//! # or: file = "mesh.msh"  (gmsh 4.1, physical groups name the boundaries)
 //!
 //! [fluid.initial]
 //! state = [1.0, 0.0, 0.0, 0.0, 1.0]            # [ρ, u, v, w, p] everywhere ...

@@ -191,7 +191,7 @@ impl RigidBody {
                     format!("\"{}\" is not among dofs {:?}", p.dof, self.dofs),
                 ));
             }
-            if !p.amplitude.is_finite() || !(p.frequency.is_finite() && p.frequency >= 0.0) {
+            if !(p.amplitude.is_finite() && p.frequency.is_finite() && p.frequency >= 0.0) {
                 return Err((
                     f("prescribed"),
                     "expected a finite amplitude and a frequency >= 0".into(),

@@ -108,6 +108,7 @@ impl Control {
         };
         let server = control_service(&node, run_id, role)?
             .server_builder()
+            .set_backpressure_handler(super::data::retry_until(timeouts.delivery))
             .create()
             .map_err(|e| ipc_err("cannot create the command server", e))?;
         let listener = event(&node, run_id, role.name())?

@@ -69,7 +69,6 @@ impl<T: Plain> SliceWriter<T> {
     ) -> Result<Self, ProtocolError> {
         let initial_len = initial_len.max(1);
         check_room::<T>(initial_len, name)?;
-        let delivery = timeouts.delivery;
         let publisher = open_service::<T>(node, run_id, name, history)?
             .publisher_builder()
             .initial_max_slice_len(initial_len)
@@ -77,14 +76,7 @@ impl<T: Plain> SliceWriter<T> {
             .max_loaned_samples(1)
             // Lockstep: a full reader buffer means the reader is behind; retry until the delivery
             // deadline, then fail the send instead of dropping or spinning forever.
-            .set_backpressure_handler(move |info: &iceoryx2::port::BackpressureInfo| {
-                if info.elapsed_time < delivery {
-                    std::thread::sleep(Duration::from_micros(200));
-                    BackpressureAction::Retry
-                } else {
-                    BackpressureAction::DiscardDataAndFail
-                }
-            })
+            .set_backpressure_handler(retry_until(timeouts.delivery))
             .create()
             .map_err(|e| ipc_err(&format!("cannot create the publisher of {name}"), e))?;
         Ok(SliceWriter { publisher, name, checked: initial_len })
@@ -120,6 +112,21 @@ impl<T: Plain> SliceWriter<T> {
             ))
         })?;
         Ok(out)
+    }
+}
+
+/// A backpressure handler that retries for `delivery`, then fails the send
+/// (`SendError::UnableToDeliver`).
+pub(crate) fn retry_until(
+    delivery: Duration,
+) -> impl Fn(&iceoryx2::port::BackpressureInfo) -> BackpressureAction + Send + 'static {
+    move |info| {
+        if info.elapsed_time < delivery {
+            std::thread::sleep(Duration::from_micros(200));
+            BackpressureAction::Retry
+        } else {
+            BackpressureAction::DiscardDataAndFail
+        }
     }
 }
 

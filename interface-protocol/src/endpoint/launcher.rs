@@ -56,7 +56,6 @@ impl LauncherLink {
     /// Creates the run's services under `run_id` (after removing stale files of dead runs).
     /// `timeouts.delivery` bounds the send of a command; waits take explicit deadlines.
     pub fn open(run_id: &str, timeouts: Timeouts) -> Result<LauncherLink, ProtocolError> {
-        let _ = timeouts;
         services::validate_run_id(run_id)?;
         shm::cleanup_stale_runs();
         let watch = Watch::signals_only();
@@ -70,6 +69,7 @@ impl LauncherLink {
                 pending: None,
                 client: control_service(&node, run_id, role)?
                     .client_builder()
+                    .set_backpressure_handler(super::data::retry_until(timeouts.delivery))
                     .create()
                     .map_err(|e| ipc_err("cannot create a command client", e))?,
                 hello: hello_service(&node, run_id, role)?

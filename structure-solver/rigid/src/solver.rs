@@ -297,3 +297,129 @@ mod tests {
         assert_eq!(lines.count(), 101);
     }
 }
+
+#[cfg(test)]
+mod coupled_tests {
+    //! The rigid solver through the real transport: a launcher thread drives the coupling
+    //! sequence, an analytic piston face answers in a fluid thread, and the piston's motion is
+    //! compared with the closed form of m u'' + ρ0 c0 A u' + k u = -A p0.
+    use super::*;
+    use interface_protocol::endpoint::{ControlPort, FluidEndpoint, LauncherLink, Timeouts};
+    use interface_protocol::handshake::HelloInfo;
+    use interface_protocol::messages::{command_kind, reply_kind, Reply, Role};
+    use interface_protocol::participant::serve;
+    use std::path::Path;
+    use std::time::{Duration, Instant};
+
+    const M: f64 = 10.0;
+    const K: f64 = 1e5;
+    const A: f64 = 0.1;
+    const P0: f64 = 1e5;
+    const Z: f64 = 1.2 * 340.0; // ρ0 c0
+    const T_END: f64 = 0.1;
+
+    fn exact(t: f64) -> f64 {
+        let ueq = -A * P0 / K;
+        let g = Z * A / (2.0 * M);
+        let wd = (K / M - g * g).sqrt();
+        ueq + (-g * t).exp() * (-ueq * (wd * t).cos() - g * ueq / wd * (wd * t).sin())
+    }
+
+    /// The face: answers every fluid command with F = -A (p0 + ρ0 c0 v_x) on its single node.
+    fn fluid(run_id: String) {
+        let mut f =
+            FluidEndpoint::open(&run_id, HelloInfo::default(), Timeouts::default()).unwrap();
+        loop {
+            let c = f.control().next_command().unwrap();
+            if c.kind == command_kind::INIT {
+                f.read_topology(|_, _| ()).unwrap();
+            }
+            if c.kind == command_kind::INIT || c.kind == command_kind::ADVANCE {
+                f.answer_kinematics(|_, nodes, loads| {
+                    loads[0].f = [-A * (P0 + Z * nodes[0].v[0]), 0.0, 0.0];
+                })
+                .unwrap();
+            }
+            f.control().reply(&Reply::done(c.step, c.t_to, f64::INFINITY, 0.0, 0.0)).unwrap();
+            if c.kind == command_kind::FINISH {
+                return;
+            }
+        }
+    }
+
+    /// Drives one coupled run (coupling-sequence) and returns the largest displacement error.
+    fn coupled_error(scheme: &str, dt: f64) -> f64 {
+        let run_id = format!("t{}-rigid-{scheme}-{}", std::process::id(), (1.0 / dt).round());
+        let dir = tempfile::tempdir().unwrap();
+        let text = format!(
+            "[coupling]\nscheme = \"{scheme}\"\ndt = {dt:e}\nt_end = {T_END:e}\n\
+             [structure.rigid]\nmass = {M:e}\nstiffness = {K:e}\n"
+        );
+        let case = Case::parse(&text, Path::new("case.toml"), &[]).unwrap();
+        let mut link = LauncherLink::open(&run_id, Timeouts::default()).unwrap();
+        let structure = {
+            let (run_id, case, out) = (run_id.clone(), case.clone(), dir.path().to_path_buf());
+            std::thread::spawn(move || {
+                let mut solver = RigidSolver::new(&case, out).unwrap();
+                let info = HelloInfo { n_surface_nodes: 1, n_surface_elements: 0, case_hash: 0 };
+                let mut ep = StructureEndpoint::open(&run_id, info, Timeouts::default()).unwrap();
+                serve(&mut ep, &mut solver).unwrap();
+            })
+        };
+        let fluid = std::thread::spawn({
+            let run_id = run_id.clone();
+            move || fluid(run_id)
+        });
+        let soon = Instant::now() + Duration::from_secs(10);
+        link.wait_hello(Role::Fluid, soon).unwrap();
+        link.wait_hello(Role::Structure, soon).unwrap();
+        let mut go = |role: Role, c: Command| {
+            link.send(role, &c).unwrap();
+            let r = link.wait_reply(role, Instant::now() + Duration::from_secs(10)).unwrap();
+            assert_ne!(r.kind, reply_kind::FAILED, "{}: {}", c.describe(), r.message_str());
+        };
+        let c = &case.coupling;
+        let n = c.n_steps();
+        go(Role::Structure, Command::init());
+        go(Role::Fluid, Command::init());
+        go(Role::Structure, Command::advance(0, 0.0, 0.0, scheme_phase::START));
+        if c.scheme == Scheme::C0 {
+            go(Role::Fluid, Command::advance(0, 0.0, dt / 2.0, scheme_phase::START));
+        }
+        for k in 0..n {
+            let t0 = k as f64 * dt;
+            let t1 = if k + 1 == n { c.t_end } else { t0 + dt };
+            go(Role::Structure, Command::advance(k, t0, t1, scheme_phase::PREDICT));
+            let (from, to) = match c.scheme {
+                Scheme::Css => (t0, t1),
+                Scheme::C0 => (t0 + dt / 2.0, t1 + dt / 2.0),
+                Scheme::A6 => ((t0 - dt / 2.0).max(0.0), t0 + dt / 2.0),
+            };
+            go(Role::Fluid, Command::advance(k, from, to, scheme_phase::NONE));
+            go(Role::Structure, Command::advance(k, t0, t1, scheme_phase::CORRECT));
+        }
+        go(Role::Structure, Command::finish());
+        go(Role::Fluid, Command::finish());
+        structure.join().unwrap();
+        fluid.join().unwrap();
+        link.remove_resources().unwrap();
+        let csv = std::fs::read_to_string(dir.path().join("structure_probes.csv")).unwrap();
+        let rows: Vec<Vec<f64>> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(rows.len() as u64, n + 1);
+        rows.iter().map(|r| (r[1] - exact(r[0])).abs()).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn coupled_piston_converges_at_the_order_of_each_scheme() {
+        for (scheme, lo, hi) in [("C0", 1.8, 2.3), ("A6", 1.8, 2.3), ("CSS", 0.7, 1.3)] {
+            let e = [coupled_error(scheme, 1e-3), coupled_error(scheme, 5e-4)];
+            let p = (e[0] / e[1]).log2();
+            eprintln!("{scheme}: max errors {e:?}, observed order {p:.2}");
+            assert!((lo..hi).contains(&p), "{scheme}: errors {e:?}, order {p}");
+        }
+    }
+}

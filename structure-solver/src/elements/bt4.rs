@@ -62,7 +62,12 @@ pub struct Bt4Settings {
 
 impl Default for Bt4Settings {
     fn default() -> Self {
-        Bt4Settings { rule: ThicknessRule::gauss(5), hourglass: 0.05, newton: 3, rotary: RotaryInertia::Scaled }
+        Bt4Settings {
+            rule: ThicknessRule::gauss(5),
+            hourglass: 0.05,
+            newton: 3,
+            rotary: RotaryInertia::Scaled,
+        }
     }
 }
 
@@ -139,14 +144,29 @@ fn frame<R: Real>(x: &[[R; 3]; 4]) -> Frame<R> {
     }
     let two_a = (lx[2] - lx[0]) * (ly[3] - ly[1]) - (lx[3] - lx[1]) * (ly[2] - ly[0]);
     let inv = R::splat(1.0) / two_a;
-    let b1 = [(ly[1] - ly[3]) * inv, (ly[2] - ly[0]) * inv, (ly[3] - ly[1]) * inv, (ly[0] - ly[2]) * inv];
-    let b2 = [(lx[3] - lx[1]) * inv, (lx[0] - lx[2]) * inv, (lx[1] - lx[3]) * inv, (lx[2] - lx[0]) * inv];
+    let b1 = [
+        (ly[1] - ly[3]) * inv,
+        (ly[2] - ly[0]) * inv,
+        (ly[3] - ly[1]) * inv,
+        (ly[0] - ly[2]) * inv,
+    ];
+    let b2 = [
+        (lx[3] - lx[1]) * inv,
+        (lx[0] - lx[2]) * inv,
+        (lx[1] - lx[3]) * inv,
+        (lx[2] - lx[0]) * inv,
+    ];
     Frame { e: [e1, e2, e3], x: lx, y: ly, z: lz, b1, b2, area: two_a * R::splat(0.5) }
 }
 
 impl Bt4 {
     /// A part; `thickness` per element.
-    pub fn new(conn: Vec<[u32; 4]>, thickness: Vec<f64>, material: J2, settings: Bt4Settings) -> Self {
+    pub fn new(
+        conn: Vec<[u32; 4]>,
+        thickness: Vec<f64>,
+        material: J2,
+        settings: Bt4Settings,
+    ) -> Self {
         assert_eq!(conn.len(), thickness.len(), "one thickness per element");
         let nb = conn.len().div_ceil(LANES);
         let np = settings.rule.len();
@@ -242,22 +262,46 @@ impl Bt4 {
             let xe = conn.map(|n| x[n as usize]);
             let a = frame(&xe).area;
             let d = |i: usize, j: usize| {
-                ((xe[i][0] - xe[j][0]).powi(2) + (xe[i][1] - xe[j][1]).powi(2) + (xe[i][2] - xe[j][2]).powi(2)).sqrt()
+                ((xe[i][0] - xe[j][0]).powi(2)
+                    + (xe[i][1] - xe[j][1]).powi(2)
+                    + (xe[i][2] - xe[j][2]).powi(2))
+                .sqrt()
             };
             let l = a / d(0, 2).max(d(1, 3));
             let a_rot = match self.settings.rotary {
                 RotaryInertia::Physical => 0.0,
                 RotaryInertia::Scaled => a,
             };
-            let w2 = (12.0 * SHEAR_FACTOR * el.shear_modulus() + 4.0 * el.e * h * h / a) / (el.rho * (h * h + a_rot));
+            let w2 = (12.0 * SHEAR_FACTOR * el.shear_modulus() + 4.0 * el.e * h * h / a)
+                / (el.rho * (h * h + a_rot));
             dt = dt.min(l / c).min(2.0 / w2.sqrt());
         }
         dt
     }
 
     /// Adds the internal forces (6 per node, global frame) of the step with end positions
-    /// `x_end` and increment `du` (6 per node) to `f`, writing the trial state.
+    /// `x_end` and increment `du` (6 per node) to `f`, writing the trial state. Uses AVX2 and
+    /// FMA when the processor has them (the same kernel, compiled twice).
     pub fn internal_force(&mut self, x_end: &[[f64; 3]], du: &[f64], f: &mut [f64]) {
+        assert!(du.len() >= 6 * x_end.len() && f.len() >= 6 * x_end.len(), "6 dofs per node");
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        {
+            // SAFETY: the processor supports the features the function is compiled for.
+            unsafe { self.internal_force_avx2(x_end, du, f) };
+            return;
+        }
+        self.internal_force_blocks(x_end, du, f);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn internal_force_avx2(&mut self, x_end: &[[f64; 3]], du: &[f64], f: &mut [f64]) {
+        self.internal_force_blocks(x_end, du, f);
+    }
+
+    #[inline(always)]
+    fn internal_force_blocks(&mut self, x_end: &[[f64; 3]], du: &[f64], f: &mut [f64]) {
         let nb = self.n_blocks();
         let np = self.settings.rule.len();
         let ne = self.conn.len();

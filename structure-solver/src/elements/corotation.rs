@@ -243,7 +243,11 @@ mod tests {
         let cases: Vec<(FrameRule, Vec<Vector3<f64>>)> = vec![
             (
                 FrameRule::Triangle,
-                vec![Vector3::new(0.0, 0.0, 0.0), Vector3::new(1.0, 0.1, 0.0), Vector3::new(0.2, 0.9, 0.1)],
+                vec![
+                    Vector3::new(0.0, 0.0, 0.0),
+                    Vector3::new(1.0, 0.1, 0.0),
+                    Vector3::new(0.2, 0.9, 0.1),
+                ],
             ),
             (
                 FrameRule::Quad,
@@ -254,18 +258,25 @@ mod tests {
                     Vector3::new(-0.1, 1.0, -0.03),
                 ],
             ),
-            (FrameRule::Beam { q0: [0.0, 1.0, 0.0] }, vec![Vector3::new(0.0, 0.0, 0.0), Vector3::new(2.0, 0.0, 0.0)]),
+            (
+                FrameRule::Beam { q0: [0.0, 1.0, 0.0] },
+                vec![Vector3::new(0.0, 0.0, 0.0), Vector3::new(2.0, 0.0, 0.0)],
+            ),
         ];
         for (rule, x0) in cases {
             let n = x0.len();
             let re = Reference::new(rule, &x0);
             // a symmetric positive local stiffness
-            let m = DMatrix::from_fn(6 * n, 6 * n, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.4);
+            let m =
+                DMatrix::from_fn(6 * n, 6 * n, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0 - 0.4);
             let k = &m * m.transpose() + DMatrix::identity(6 * n, 6 * n);
             let x: Vec<_> = x0
                 .iter()
                 .enumerate()
-                .map(|(i, p)| exp(&Vector3::new(0.3, -0.5, 0.8)) * p + Vector3::new(0.05 * i as f64, 0.02, -0.03 * i as f64))
+                .map(|(i, p)| {
+                    exp(&Vector3::new(0.3, -0.5, 0.8)) * p
+                        + Vector3::new(0.05 * i as f64, 0.02, -0.03 * i as f64)
+                })
                 .collect();
             let r: Vec<_> = (0..n)
                 .map(|i| exp(&Vector3::new(0.3 + 0.05 * i as f64, -0.5, 0.8 - 0.04 * i as f64)))
@@ -273,9 +284,20 @@ mod tests {
             let (_, f) = energy_and_force(&re, &k, &x, &r);
             let mut d = vec![0.0; 6 * n];
             let mut fast = vec![0.0; 6 * n];
-            re.force(&x, &r, &mut d, |d, fl| fl.copy_from_slice((&k * nalgebra::DVector::from_column_slice(d)).as_slice()), &mut fast);
+            re.force(
+                &x,
+                &r,
+                &mut d,
+                |d, fl| {
+                    fl.copy_from_slice((&k * nalgebra::DVector::from_column_slice(d)).as_slice())
+                },
+                &mut fast,
+            );
             for (a, b) in fast.iter().zip(&f) {
-                assert!((a - b).abs() < 1e-12 * (1.0 + b.abs()), "{rule:?}: fast force {a} vs Bᵀf {b}");
+                assert!(
+                    (a - b).abs() < 1e-12 * (1.0 + b.abs()),
+                    "{rule:?}: fast force {a} vs Bᵀf {b}"
+                );
             }
             let h = 1e-6;
             for j in 0..n {
@@ -283,15 +305,27 @@ mod tests {
                     let (mut xp, mut xm) = (x.clone(), x.clone());
                     xp[j][c] += h;
                     xm[j][c] -= h;
-                    let fd = (energy_and_force(&re, &k, &xp, &r).0 - energy_and_force(&re, &k, &xm, &r).0) / (2.0 * h);
-                    assert!((fd - f[6 * j + c]).abs() < 1e-6, "{rule:?} node {j} dir {c}: {fd} vs {}", f[6 * j + c]);
+                    let fd = (energy_and_force(&re, &k, &xp, &r).0
+                        - energy_and_force(&re, &k, &xm, &r).0)
+                        / (2.0 * h);
+                    assert!(
+                        (fd - f[6 * j + c]).abs() < 1e-6,
+                        "{rule:?} node {j} dir {c}: {fd} vs {}",
+                        f[6 * j + c]
+                    );
                     let mut w = Vector3::zeros();
                     w[c] = h;
                     let (mut rp, mut rm) = (r.clone(), r.clone());
                     rp[j] = exp(&w) * r[j];
                     rm[j] = exp(&(-w)) * r[j];
-                    let fd = (energy_and_force(&re, &k, &x, &rp).0 - energy_and_force(&re, &k, &x, &rm).0) / (2.0 * h);
-                    assert!((fd - f[6 * j + 3 + c]).abs() < 1e-6, "{rule:?} node {j} rot {c}: {fd} vs {}", f[6 * j + 3 + c]);
+                    let fd = (energy_and_force(&re, &k, &x, &rp).0
+                        - energy_and_force(&re, &k, &x, &rm).0)
+                        / (2.0 * h);
+                    assert!(
+                        (fd - f[6 * j + 3 + c]).abs() < 1e-6,
+                        "{rule:?} node {j} rot {c}: {fd} vs {}",
+                        f[6 * j + 3 + c]
+                    );
                 }
             }
         }

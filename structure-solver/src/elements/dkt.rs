@@ -67,7 +67,12 @@ fn kirchhoff_map(xy: &[[f64; 2]; 3]) -> DMatrix<f64> {
 pub fn stiffness(xy: &[[f64; 2]; 3], sec: &ShellSection) -> DMatrix<f64> {
     let to_d = |m: [[f64; 3]; 3]| DMatrix::from_fn(3, 3, |i, j| m[i][j]);
     let (dm, db) = (to_d(sec.membrane()), to_d(sec.bending()));
-    let j = Matrix2::new(xy[1][0] - xy[0][0], xy[1][1] - xy[0][1], xy[2][0] - xy[0][0], xy[2][1] - xy[0][1]);
+    let j = Matrix2::new(
+        xy[1][0] - xy[0][0],
+        xy[1][1] - xy[0][1],
+        xy[2][0] - xy[0][0],
+        xy[2][1] - xy[0][1],
+    );
     let det = j.determinant();
     let area = 0.5 * det;
     let jinv = j.try_inverse().expect("degenerate triangle");
@@ -128,5 +133,6 @@ pub fn stiffness(xy: &[[f64; 2]; 3], sec: &ShellSection) -> DMatrix<f64> {
 
 /// Area of the triangle.
 pub fn area(xy: &[[f64; 2]; 3]) -> f64 {
-    0.5 * ((xy[1][0] - xy[0][0]) * (xy[2][1] - xy[0][1]) - (xy[2][0] - xy[0][0]) * (xy[1][1] - xy[0][1]))
+    0.5 * ((xy[1][0] - xy[0][0]) * (xy[2][1] - xy[0][1])
+        - (xy[2][0] - xy[0][0]) * (xy[1][1] - xy[0][1]))
 }

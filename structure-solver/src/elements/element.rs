@@ -23,7 +23,10 @@ pub enum ElementKind {
 #[derive(Debug, Clone)]
 enum Body {
     /// Corotated element with a constant local stiffness.
-    Corotated { reference: Reference, k: DMatrix<f64> },
+    Corotated {
+        reference: Reference,
+        k: DMatrix<f64>,
+    },
     Tet(Tet4),
 }
 
@@ -38,6 +41,9 @@ pub struct Element {
     /// Mid-surface area (shells), length (beams) or volume (tets).
     pub measure: f64,
 }
+
+/// A configuration-dependent load: nodal positions to nodal forces (6 per node).
+pub type LoadFn = dyn Fn(&[Vector3<f64>], &mut [f64]) + Sync;
 
 /// Relative step of the finite-difference tangent.
 const FD_STEP: f64 = 1e-6;
@@ -61,7 +67,14 @@ impl Element {
         Self::shell(ElementKind::Tri3, nodes.to_vec(), reference, k, area, sec)
     }
 
-    fn shell(kind: ElementKind, nodes: Vec<usize>, reference: Reference, k: DMatrix<f64>, area: f64, sec: &ShellSection) -> Self {
+    fn shell(
+        kind: ElementKind,
+        nodes: Vec<usize>,
+        reference: Reference,
+        k: DMatrix<f64>,
+        area: f64,
+        sec: &ShellSection,
+    ) -> Self {
         let n = nodes.len() as f64;
         let m = sec.rho * sec.h * area / n;
         let i = sec.rho * sec.h.powi(3) / 12.0 * area / n;
@@ -70,7 +83,12 @@ impl Element {
     }
 
     /// A 2-node beam; `up` fixes the local `y` axis (projected normal to the beam).
-    pub fn beam2(nodes: [usize; 2], x0: &[Vector3<f64>; 2], up: Vector3<f64>, sec: &BeamSection) -> Self {
+    pub fn beam2(
+        nodes: [usize; 2],
+        x0: &[Vector3<f64>; 2],
+        up: Vector3<f64>,
+        sec: &BeamSection,
+    ) -> Self {
         let chord = x0[1] - x0[0];
         let l = chord.norm();
         let e1 = chord / l;
@@ -79,10 +97,17 @@ impl Element {
         let k = beam::stiffness(l, sec);
         let m = sec.rho * sec.area * l / 2.0;
         // section inertia (torsion, y, z) rotated to global, diagonal kept
-        let local = Matrix3::from_diagonal(&Vector3::new(sec.iy + sec.iz, sec.iy, sec.iz)) * (sec.rho * l / 2.0);
+        let local = Matrix3::from_diagonal(&Vector3::new(sec.iy + sec.iz, sec.iy, sec.iz))
+            * (sec.rho * l / 2.0);
         let g = reference.e0 * local * reference.e0.transpose();
         let mass = (0..2).flat_map(|_| [m, m, m, g[(0, 0)], g[(1, 1)], g[(2, 2)]]).collect();
-        Element { kind: ElementKind::Beam2, nodes: nodes.to_vec(), body: Body::Corotated { reference, k }, mass, measure: l }
+        Element {
+            kind: ElementKind::Beam2,
+            nodes: nodes.to_vec(),
+            body: Body::Corotated { reference, k },
+            mass,
+            measure: l,
+        }
     }
 
     /// A 4-node tetrahedron of density `rho`.
@@ -91,7 +116,13 @@ impl Element {
         let m = rho * tet.volume / 4.0;
         let mass = (0..4).flat_map(|_| [m, m, m, 0.0, 0.0, 0.0]).collect();
         let measure = tet.volume;
-        Element { kind: ElementKind::Tet4, nodes: nodes.to_vec(), body: Body::Tet(tet), mass, measure }
+        Element {
+            kind: ElementKind::Tet4,
+            nodes: nodes.to_vec(),
+            body: Body::Tet(tet),
+            mass,
+            measure,
+        }
     }
 
     /// `true` if the element has rotational freedoms.
@@ -141,7 +172,7 @@ impl Element {
         &self,
         x: &[Vector3<f64>],
         r: &[Matrix3<f64>],
-        extra: Option<&dyn Fn(&[Vector3<f64>], &mut [f64])>,
+        extra: Option<&LoadFn>,
     ) -> DMatrix<f64> {
         let n = x.len();
         let size = 6 * n;
@@ -206,7 +237,9 @@ impl Element {
             })
             .collect();
         // symmetric form M^-1/2 K M^-1/2
-        let s = DMatrix::from_fn(size, size, |i, j| 0.5 * (k[(i, j)] + k[(j, i)]) * (minv[i] * minv[j]).sqrt());
+        let s = DMatrix::from_fn(size, size, |i, j| {
+            0.5 * (k[(i, j)] + k[(j, i)]) * (minv[i] * minv[j]).sqrt()
+        });
         let ev = s.symmetric_eigenvalues();
         ev.iter().cloned().fold(0.0, f64::max)
     }

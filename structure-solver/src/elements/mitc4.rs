@@ -138,5 +138,6 @@ pub fn stiffness(xy: &[[f64; 2]; 4], sec: &ShellSection) -> DMatrix<f64> {
 
 /// Area of the flat quad.
 pub fn area(xy: &[[f64; 2]; 4]) -> f64 {
-    0.5 * ((xy[2][0] - xy[0][0]) * (xy[3][1] - xy[1][1]) - (xy[3][0] - xy[1][0]) * (xy[2][1] - xy[0][1]))
+    0.5 * ((xy[2][0] - xy[0][0]) * (xy[3][1] - xy[1][1])
+        - (xy[3][0] - xy[1][0]) * (xy[2][1] - xy[0][1]))
 }

@@ -60,12 +60,25 @@ impl BeamSection {
     pub fn rectangle(e: f64, nu: f64, rho: f64, b: f64, h: f64) -> Self {
         let (a, c) = (b.max(h), b.min(h));
         let j = a * c.powi(3) * (1.0 / 3.0 - 0.21 * c / a * (1.0 - c.powi(4) / (12.0 * a.powi(4))));
-        BeamSection { e, nu, rho, area: b * h, iy: b * h.powi(3) / 12.0, iz: h * b.powi(3) / 12.0, j }
+        BeamSection {
+            e,
+            nu,
+            rho,
+            area: b * h,
+            iy: b * h.powi(3) / 12.0,
+            iz: h * b.powi(3) / 12.0,
+            j,
+        }
     }
 }
 
 /// `Bᵀ D B` scaled by `w` added into `k` (B: rows × n, D: rows × rows).
-pub(crate) fn add_btdb(k: &mut nalgebra::DMatrix<f64>, b: &nalgebra::DMatrix<f64>, d: &nalgebra::DMatrix<f64>, w: f64) {
+pub(crate) fn add_btdb(
+    k: &mut nalgebra::DMatrix<f64>,
+    b: &nalgebra::DMatrix<f64>,
+    d: &nalgebra::DMatrix<f64>,
+    w: f64,
+) {
     let db = d * b;
     k.gemm_tr(w, b, &db, 1.0);
 }

@@ -151,8 +151,7 @@ impl J2 {
                     break;
                 }
                 // dκ/dΔγ = H sqrt(2/3) (ξ + Δγ ξ'), ξ' = (ξ²)' / (2ξ).
-                let dkappa =
-                    h * R::splat(SQRT_2_3) * (xi + dgamma * dxi2 * R::splat(0.5) / xi);
+                let dkappa = h * R::splat(SQRT_2_3) * (xi + dgamma * dxi2 * R::splat(0.5) / xi);
                 let df = R::splat(0.5) * dxi2 - R::splat(2.0 / 3.0) * kappa * dkappa;
                 dgamma = R::select(yielding, dgamma - f / df, dgamma);
             }
@@ -161,10 +160,9 @@ impl J2 {
         let s2 = half_diff / (one + c2 * dgamma);
         let sxy = trial[2] / (one + c2 * dgamma);
         let sigma = [s1 * R::splat(0.5) - s2, s1 * R::splat(0.5) + s2, sxy];
-        let xi = (s1 * s1 * R::splat(1.0 / 6.0)
-            + s2 * s2 * R::splat(2.0)
-            + sxy * sxy * R::splat(2.0))
-        .sqrt();
+        let xi =
+            (s1 * s1 * R::splat(1.0 / 6.0) + s2 * s2 * R::splat(2.0) + sxy * sxy * R::splat(2.0))
+                .sqrt();
         PlaneStressReturn { sigma, alpha: alpha + R::splat(SQRT_2_3) * dgamma * xi, dgamma }
     }
 
@@ -225,7 +223,11 @@ pub struct J2StatePlane {
 
 impl J2 {
     /// Stress, updated state and consistent tangent at total strain `eps` (3D).
-    pub fn update_3d(&self, eps: &[f64; 6], state: &J2State3d) -> ([f64; 6], J2State3d, [[f64; 6]; 6]) {
+    pub fn update_3d(
+        &self,
+        eps: &[f64; 6],
+        state: &J2State3d,
+    ) -> ([f64; 6], J2State3d, [[f64; 6]; 6]) {
         let ee: [f64; 6] = std::array::from_fn(|i| eps[i] - state.eps_p[i]);
         let r = self.return_3d(&self.elastic.stress_3d(&ee), state.alpha);
         let mut eps_p = state.eps_p;
@@ -244,7 +246,8 @@ impl J2 {
         state: &J2StatePlane,
     ) -> ([f64; 3], J2StatePlane, [[f64; 3]; 3]) {
         let ee: [f64; 3] = std::array::from_fn(|i| eps[i] - state.eps_p[i]);
-        let r = self.return_plane_stress(self.elastic.stress_plane_stress(&ee), state.alpha, 50, 1e-14);
+        let r =
+            self.return_plane_stress(self.elastic.stress_plane_stress(&ee), state.alpha, 50, 1e-14);
         let n = p_times(&r.sigma);
         let eps_p = std::array::from_fn(|i| state.eps_p[i] + r.dgamma * n[i]);
         (r.sigma, J2StatePlane { eps_p, alpha: r.alpha }, self.tangent_plane_stress(&r))

@@ -18,7 +18,10 @@ pub fn grid(nu: usize, nv: usize, f: impl Fn(f64, f64) -> [f64; 3]) -> Mesh {
     let id = |i: usize, j: usize| j * (nu + 1) + i;
     for j in 0..nv {
         for i in 0..nu {
-            m.cells.push(Cell { kind: CellKind::Quad4, nodes: vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)] });
+            m.cells.push(Cell {
+                kind: CellKind::Quad4,
+                nodes: vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)],
+            });
         }
     }
     m.node_sets.insert("u0".into(), (0..=nv).map(|j| id(0, j)).collect());

@@ -12,7 +12,8 @@ use super::{Cell, CellKind, Mesh, MeshError};
 /// Reads a gmsh 4.1 file.
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Read { file: file.clone(), message: e.to_string() })?;
+    let bytes = std::fs::read(path)
+        .map_err(|e| MeshError::Read { file: file.clone(), message: e.to_string() })?;
     parse(&bytes, &file)
 }
 
@@ -39,7 +40,8 @@ fn physical_names(bytes: &[u8]) -> HashMap<(i32, i32), String> {
 /// Parses the bytes of a gmsh 4.1 file named `file` (for messages).
 pub fn parse(bytes: &[u8], file: &str) -> Result<Mesh, MeshError> {
     let err = |message: String| MeshError::Read { file: file.to_string(), message };
-    let msh = mshio::parse_msh_bytes(bytes).map_err(|e| err(format!("not a gmsh 4.1 mesh: {e}")))?;
+    let msh =
+        mshio::parse_msh_bytes(bytes).map_err(|e| err(format!("not a gmsh 4.1 mesh: {e}")))?;
     let names = physical_names(bytes);
     let data = msh.data;
     let nodes = data.nodes.ok_or_else(|| err("no $Nodes section".into()))?;
@@ -54,7 +56,10 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<Mesh, MeshError> {
                 }
                 v
             }
-            None => (0..block.nodes.len() as u64).map(|i| nodes.min_node_tag + i).collect(),
+            // dense tags across the file: mshio drops them, they run on from the minimum
+            None => (0..block.nodes.len() as u64)
+                .map(|i| nodes.min_node_tag + mesh.nodes.len() as u64 + i)
+                .collect(),
         };
         for (n, tag) in block.nodes.iter().zip(tags) {
             index.insert(tag, mesh.nodes.len());
@@ -87,14 +92,23 @@ pub fn parse(bytes: &[u8], file: &str) -> Result<Mesh, MeshError> {
             ElementType::Qua4 => Some(CellKind::Quad4),
             ElementType::Tet4 => Some(CellKind::Tet4),
             ElementType::Pnt => None,
-            other => return Err(err(format!("element type {other:?} is not supported (lines, triangles, quads, tets)"))),
+            other => {
+                return Err(err(format!(
+                    "element type {other:?} is not supported (lines, triangles, quads, tets)"
+                )))
+            }
         };
-        let groups = physical.get(&(block.entity_dim, block.entity_tag)).cloned().unwrap_or_default();
-        let set_name = |g: i32| names.get(&(block.entity_dim, g)).cloned().unwrap_or_else(|| format!("physical_{g}"));
+        let groups =
+            physical.get(&(block.entity_dim, block.entity_tag)).cloned().unwrap_or_default();
+        let set_name = |g: i32| {
+            names.get(&(block.entity_dim, g)).cloned().unwrap_or_else(|| format!("physical_{g}"))
+        };
         for e in &block.elements {
             let mut nn = Vec::with_capacity(e.nodes.len());
             for t in &e.nodes {
-                nn.push(*index.get(t).ok_or_else(|| err(format!("element {} names unknown node {t}", e.element_tag)))?);
+                nn.push(*index.get(t).ok_or_else(|| {
+                    err(format!("element {} names unknown node {t}", e.element_tag))
+                })?);
             }
             for &g in &groups {
                 node_sets.entry(set_name(g)).or_default().extend(nn.iter().copied());

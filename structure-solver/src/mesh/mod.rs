@@ -62,7 +62,9 @@ impl Mesh {
     /// The node nearest to `p`.
     pub fn nearest_node(&self, p: [f64; 3]) -> usize {
         let d2 = |q: &[f64; 3]| (0..3).map(|c| (q[c] - p[c]).powi(2)).sum::<f64>();
-        (0..self.nodes.len()).min_by(|&a, &b| d2(&self.nodes[a]).total_cmp(&d2(&self.nodes[b]))).unwrap_or(0)
+        (0..self.nodes.len())
+            .min_by(|&a, &b| d2(&self.nodes[a]).total_cmp(&d2(&self.nodes[b])))
+            .unwrap_or(0)
     }
 
     /// Nodes satisfying `pred`, in index order.

@@ -172,7 +172,10 @@ impl Implicit {
                     continue;
                 }
                 let inertia = self.inertia(i, mass[i], dt);
-                reference = reference.max(inertia.abs()).max(self.fi[i].abs()).max((self.r[i] + self.fi[i]).abs());
+                reference = reference
+                    .max(inertia.abs())
+                    .max(self.fi[i].abs())
+                    .max((self.r[i] + self.fi[i]).abs());
                 self.r[i] -= inertia;
                 rn += self.r[i] * self.r[i];
             }
@@ -201,8 +204,9 @@ impl Implicit {
                     free.push(Triplet::new(*k, *k, cm * mass[i]));
                 }
             }
-            let jac = SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
-                .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
+            let jac =
+                SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
+                    .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
             let lu = jac.sp_lu().map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
             let mut rhs = Mat::<f64>::zeros(self.n_free, 1);
             for (i, f) in self.free.iter().enumerate() {

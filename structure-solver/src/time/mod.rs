@@ -40,7 +40,13 @@ fn prescribed_increment(model: &dyn Model, t: f64, dt: f64, scratch: &mut [f64],
 
 /// `f_ext(t) + extra - f_int` at the model's current configuration, written into `r`;
 /// `f_int` is left in `fi`.
-fn out_of_balance(model: &mut dyn Model, t: f64, extra: Option<&[f64]>, fi: &mut [f64], r: &mut [f64]) {
+fn out_of_balance(
+    model: &mut dyn Model,
+    t: f64,
+    extra: Option<&[f64]>,
+    fi: &mut [f64],
+    r: &mut [f64],
+) {
     fi.fill(0.0);
     model.internal_force(fi);
     r.fill(0.0);
