@@ -79,3 +79,22 @@ fn triangles_16x1_follow_the_reference() {
         0.02,
     );
 }
+
+/// Displacement control (the path solver for limit points) on the same problem: the tip
+/// deflection is driven through the table's `w_tip` values and the load factor it returns must
+/// be the table's `P / P_max`.
+#[test]
+fn displacement_control_recovers_the_load_factors() {
+    use structure_solver::statics::{displacement_control, NewtonSettings};
+    let mesh = generate::rectangle(10.0, 1.0, 16, 1);
+    let mut m = cantilever(&mesh);
+    let tip = mesh.node_set("u1").unwrap()[0];
+    let targets: Vec<f64> = ROWS.iter().map(|r| r.1[1]).collect();
+    let s = NewtonSettings { tol: 1e-7, max_iter: 25, max_cuts: 0 };
+    let steps = displacement_control(&mut m, 6 * tip + 2, &targets, &s, |_, _| {}).unwrap();
+    for (c, row) in steps.iter().zip(ROWS) {
+        let e = (c.t - row.0) / row.0;
+        println!("w_tip {:.3}: P/Pmax {:.4} vs {:.3} ({:+.2}%)", row.1[1], c.t, row.0, 100.0 * e);
+        assert!(e.abs() < 0.01, "load factor {} vs {}", c.t, row.0);
+    }
+}

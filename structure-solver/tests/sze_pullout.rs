@@ -41,6 +41,7 @@ const ROWS: &[(f64, &[f64])] = &[
 ];
 
 #[test]
+#[cfg_attr(debug_assertions, ignore = "benchmark of several seconds: run with --release")]
 fn quads_24x36_follow_the_reference() {
     let (r, l) = (4.953, 10.35);
     let mesh = generate::cylinder(r, l / 2.0, [0.0, generate::QUARTER], 36, 24);

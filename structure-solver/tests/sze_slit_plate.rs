@@ -60,6 +60,7 @@ fn run(mesh: Mesh, name: &str, tol: f64) {
 }
 
 #[test]
+#[cfg_attr(debug_assertions, ignore = "benchmark of several seconds: run with --release")]
 fn quads_10x80_follow_the_reference() {
     run(
         generate::annulus(6.0, 10.0, [0.0, 2.0 * std::f64::consts::PI], 80, 10),
@@ -71,6 +72,7 @@ fn quads_10x80_follow_the_reference() {
 /// The constant-strain membrane of the flat triangle is stiffer (-2.6% at q_max on the same
 /// mesh), held to 3%.
 #[test]
+#[cfg_attr(debug_assertions, ignore = "benchmark of several seconds: run with --release")]
 fn triangles_10x80_follow_the_reference() {
     run(
         generate::annulus(6.0, 10.0, [0.0, 2.0 * std::f64::consts::PI], 80, 10).to_triangles(),

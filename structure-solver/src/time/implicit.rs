@@ -11,6 +11,7 @@
 //! Both have the discrete frequency `tan(ΩΔt/2) = ωΔt/2` on a linear oscillator.
 
 use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Mat;
 
@@ -69,6 +70,9 @@ pub struct Implicit {
     delta: Vec<f64>,
     scratch: Vec<f64>,
     triplets: Vec<Triplet<usize, usize, f64>>,
+    /// Symbolic LU and the column pointers and row indices it was made for: reused while the
+    /// sparsity pattern of the effective matrix does not change.
+    symbolic: Option<(SymbolicLu<usize>, Vec<usize>, Vec<usize>)>,
 }
 
 impl Implicit {
@@ -117,6 +121,7 @@ impl Implicit {
             delta: vec![0.0; n],
             scratch: vec![0.0; n],
             triplets: Vec::new(),
+            symbolic: None,
         }
     }
 
@@ -207,7 +212,22 @@ impl Implicit {
             let jac =
                 SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
                     .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
-            let lu = jac.sp_lu().map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
+            let same = self.symbolic.as_ref().is_some_and(|(_, cp, ri)| {
+                cp.as_slice() == jac.symbolic().col_ptr()
+                    && ri.as_slice() == jac.symbolic().row_idx()
+            });
+            if !same {
+                let sym = SymbolicLu::try_new(jac.symbolic())
+                    .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
+                self.symbolic = Some((
+                    sym,
+                    jac.symbolic().col_ptr().to_vec(),
+                    jac.symbolic().row_idx().to_vec(),
+                ));
+            }
+            let sym = self.symbolic.as_ref().map(|s| s.0.clone()).expect("set above");
+            let lu = Lu::try_new_with_symbolic(sym, jac.as_ref())
+                .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
             let mut rhs = Mat::<f64>::zeros(self.n_free, 1);
             for (i, f) in self.free.iter().enumerate() {
                 if let Some(k) = f {
