@@ -1,6 +1,6 @@
 //! `fsi check CASE`: parse and validate a case without running it, and say what a run would do.
 
-use crate::scheme::{SchemeSettings, Sequencer};
+use crate::scheme::{scheme_name, SchemeSettings, Sequencer};
 use crate::supervise::resolve_program;
 use interface_protocol::case::Case;
 use interface_protocol::messages::Role;
@@ -21,8 +21,8 @@ pub fn check(case_file: &Path, overrides: &[String]) -> anyhow::Result<String> {
     }
     writeln!(
         w,
-        "  coupling   {:?}, dt {:e} s, t_end {:e} s: {} steps (last {:e} s), timeout {} s",
-        s.scheme,
+        "  coupling   {}, dt {:e} s, t_end {:e} s: {} steps (last {:e} s), timeout {} s",
+        scheme_name(s.scheme),
         s.dt,
         s.t_end,
         s.n_steps,

@@ -6,7 +6,7 @@
 //! participant, a silent one or Ctrl-C ends the run within about a second, with both children
 //! gone and the run's shared memory removed.
 
-use crate::scheme::{Progress, SchemeError, SchemeSettings, Sequencer};
+use crate::scheme::{scheme_name, Progress, SchemeError, SchemeSettings, Sequencer};
 use crate::supervise::{Death, LaunchArgs, Participant, Participants, SpawnError};
 use interface_protocol::case::Case;
 use interface_protocol::endpoint::{LauncherLink, ProtocolError, Timeouts};
@@ -149,9 +149,9 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
 
     let mut bar = Bar::new(settings.t_end, opts.quiet);
     bar.println(&format!(
-        "fsi: run {run_id}: {} ({:?}, dt {:e}, {} steps) -> {}",
+        "fsi: run {run_id}: {} ({}, dt {:e}, {} steps) -> {}",
         case.case.name,
-        settings.scheme,
+        scheme_name(settings.scheme),
         settings.dt,
         settings.n_steps,
         out_dir.display()
@@ -443,7 +443,7 @@ fn write_report(
     let full = LauncherReport {
         report: &report,
         run_id,
-        scheme: format!("{:?}", case.coupling.scheme),
+        scheme: scheme_name(case.coupling.scheme).to_string(),
         dt: case.coupling.dt,
         t_end: case.coupling.t_end,
         overrides: &opts.overrides,

@@ -82,6 +82,15 @@ pub struct Sequencer {
     pending: Option<(Role, Command)>,
 }
 
+/// The scheme's name as the case file spells it.
+pub fn scheme_name(scheme: Scheme) -> &'static str {
+    match scheme {
+        Scheme::Css => "CSS",
+        Scheme::C0 => "C0",
+        Scheme::A6 => "A6",
+    }
+}
+
 impl SchemeSettings {
     /// The settings of a case's `[coupling]` and `[output]` sections.
     pub fn of_case(case: &Case) -> Self {

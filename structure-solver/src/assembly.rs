@@ -13,6 +13,8 @@ use rayon::prelude::*;
 use faer::sparse::Triplet;
 
 use crate::elements::{BeamSection, Element, ElementKind, ShellSection};
+use crate::material::j2::J2State3d;
+use crate::material::Material;
 use crate::mesh::{CellKind, Mesh};
 use crate::model::Model;
 
@@ -57,16 +59,14 @@ pub enum Part {
     Shell(ShellSection),
     /// A beam whose local `y` axis is `up` projected normal to it.
     Beam(BeamSection, [f64; 3]),
-    Solid {
-        e: f64,
-        nu: f64,
-        rho: f64,
-    },
+    /// A solid of an elastic or J2 material.
+    Solid(Material),
 }
 
-/// Rotary inertia of shells: physical (`ρh³/12` per area; frequency tests and implicit runs)
+/// Rotary inertia of shells: physical (`m h²/12` per node; frequency tests and implicit runs)
 /// or scaled for explicit steps (Key & Beisinger 1971; Belytschko, Lin & Tsay 1984):
-/// `max(ρh³/12, ρ h A/12)` per area, so that the rotational modes do not set `Δt ∝ h²`.
+/// `m (h² + A)/12`, as the explicit 4-node kernel uses, so that the rotational modes do not set
+/// `Δt ∝ h²` (`m`: the node's share of the element mass, `A`: the element area).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RotaryInertia {
     Physical,
@@ -87,6 +87,8 @@ struct State {
     r: Vec<Matrix3<f64>>,
     /// Accumulated spins (only read for prescribed rotation dofs).
     spin_sum: Vec<Vector3<f64>>,
+    /// Material state per element (one point: tets; unused by elastic elements).
+    material: Vec<J2State3d>,
 }
 
 /// An assembled finite-element model.
@@ -133,18 +135,14 @@ impl FeModel {
                 (CellKind::Line2, Part::Beam(s, up)) => {
                     Element::beam2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s)
                 }
-                (CellKind::Tet4, Part::Solid { e, nu, rho }) => Element::tet4(
-                    [nd[0], nd[1], nd[2], nd[3]],
-                    &[p[0], p[1], p[2], p[3]],
-                    e,
-                    nu,
-                    rho,
-                ),
+                (CellKind::Tet4, Part::Solid(mat)) => {
+                    Element::tet4([nd[0], nd[1], nd[2], nd[3]], &[p[0], p[1], p[2], p[3]], mat)
+                }
                 (kind, p) => {
                     let part = match p {
                         Part::Shell(_) => "a shell section",
                         Part::Beam(..) => "a beam section",
-                        Part::Solid { .. } => "a solid material",
+                        Part::Solid(_) => "a solid material",
                     };
                     return Err(AssemblyError::Mismatch { cell: ci, kind, part });
                 }
@@ -163,6 +161,7 @@ impl FeModel {
             x: x0.clone(),
             r: vec![Matrix3::identity(); nn],
             spin_sum: vec![Vector3::zeros(); nn],
+            material: vec![J2State3d::default(); elements.len()],
         };
         let mut m = FeModel {
             x0,
@@ -196,9 +195,9 @@ impl FeModel {
             && matches!(e.kind, ElementKind::Quad4 | ElementKind::Tri3)
         {
             for i in 0..e.nodes.len() {
-                let scaled = m[6 * i] * e.measure / 12.0;
+                let extra = m[6 * i] * e.measure / 12.0;
                 for c in 3..6 {
-                    m[6 * i + c] = m[6 * i + c].max(scaled);
+                    m[6 * i + c] += extra;
                 }
             }
         }
@@ -364,16 +363,21 @@ impl Model for FeModel {
     fn internal_force(&mut self, f: &mut [f64]) {
         f.fill(0.0);
         let s = &self.trial;
-        let parts: Vec<Vec<f64>> = self
+        let committed = &self.committed.material;
+        let parts: Vec<(Vec<f64>, J2State3d)> = self
             .elements
             .par_iter()
-            .map(|e| {
+            .zip(committed.par_iter())
+            .map(|(e, st)| {
                 let mut fe = vec![0.0; 6 * e.nodes.len()];
-                e.force(&gather(&s.x, &e.nodes), &gather(&s.r, &e.nodes), &mut fe);
-                fe
+                let trial = e.force(&gather(&s.x, &e.nodes), &gather(&s.r, &e.nodes), st, &mut fe);
+                (fe, trial)
             })
             .collect();
-        for (e, fe) in self.elements.iter().zip(&parts) {
+        for (i, (_, st)) in parts.iter().enumerate() {
+            self.trial.material[i] = *st;
+        }
+        for (e, (fe, _)) in self.elements.iter().zip(&parts) {
             for (i, &n) in e.nodes.iter().enumerate() {
                 for c in 0..6 {
                     f[6 * n + c] += fe[6 * i + c];
@@ -414,6 +418,7 @@ impl Model for FeModel {
         out.clear();
         let pe = self.element_pressure(t);
         let s = &self.trial;
+        let committed = &self.committed.material;
         let mats: Vec<nalgebra::DMatrix<f64>> = self
             .elements
             .par_iter()
@@ -421,12 +426,13 @@ impl Model for FeModel {
             .map(|(ei, e)| {
                 let x = gather(&s.x, &e.nodes);
                 let r = gather(&s.r, &e.nodes);
+                let st = &committed[ei];
                 if pe[ei] != 0.0 {
                     let p = pe[ei];
                     let load = move |xs: &[Vector3<f64>], o: &mut [f64]| pressure_force(p, xs, o);
-                    e.tangent(&x, &r, Some(&load))
+                    e.tangent(&x, &r, st, Some(&load))
                 } else {
-                    e.tangent(&x, &r, None)
+                    e.tangent(&x, &r, st, None)
                 }
             })
             .collect();

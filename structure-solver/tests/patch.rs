@@ -5,6 +5,7 @@
 
 use structure_solver::assembly::{Curve, FeModel, Part};
 use structure_solver::elements::ShellSection;
+use structure_solver::material::{Elastic, Material};
 use structure_solver::mesh::{generate, Cell, CellKind, Mesh};
 use structure_solver::model::Model;
 use structure_solver::statics::{load_steps, NewtonSettings};
@@ -186,7 +187,7 @@ fn tet_patch() -> Mesh {
 #[test]
 fn tet_constant_strain_patch() {
     let mesh = tet_patch();
-    let mut model = FeModel::new(&mesh, |_| Part::Solid { e: 1e6, nu: 0.3, rho: 1.0 }).unwrap();
+    let mut model = FeModel::new(&mesh, |_| Part::Solid(Material::Elastic(Elastic { e: 1e6, nu: 0.3, rho: 1.0 }))).unwrap();
     let s = 1e-6;
     let grad = [[1.0, 0.3, -0.2], [0.1, -0.5, 0.4], [0.2, 0.6, 0.8]];
     let field = |p: [f64; 3]| [0, 1, 2].map(|i| s * (0..3).map(|j| grad[i][j] * p[j]).sum::<f64>());

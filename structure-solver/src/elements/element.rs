@@ -10,6 +10,8 @@ use super::rotation::exp;
 use super::section::{BeamSection, ShellSection};
 use super::tet4::Tet4;
 use super::{beam, dkt, mitc4};
+use crate::material::j2::J2State3d;
+use crate::material::Material;
 
 /// Element families, for output and sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,10 +112,10 @@ impl Element {
         }
     }
 
-    /// A 4-node tetrahedron of density `rho`.
-    pub fn tet4(nodes: [usize; 4], x0: &[Vector3<f64>; 4], e: f64, nu: f64, rho: f64) -> Self {
-        let tet = Tet4::new(x0, e, nu);
-        let m = rho * tet.volume / 4.0;
+    /// A 4-node tetrahedron.
+    pub fn tet4(nodes: [usize; 4], x0: &[Vector3<f64>; 4], material: Material) -> Self {
+        let tet = Tet4::new(x0, material.as_j2());
+        let m = material.elastic().rho * tet.volume / 4.0;
         let mass = (0..4).flat_map(|_| [m, m, m, 0.0, 0.0, 0.0]).collect();
         let measure = tet.volume;
         Element {
@@ -130,8 +132,9 @@ impl Element {
         matches!(self.body, Body::Corotated { .. })
     }
 
-    /// Internal force (6 per node, global) at nodal positions `x` and rotations `r`.
-    pub fn force(&self, x: &[Vector3<f64>], r: &[Matrix3<f64>], f: &mut [f64]) {
+    /// Internal force (6 per node, global) at nodal positions `x` and rotations `r` from the
+    /// committed material `state`; returns the trial state (unchanged for elastic elements).
+    pub fn force(&self, x: &[Vector3<f64>], r: &[Matrix3<f64>], state: &J2State3d, f: &mut [f64]) -> J2State3d {
         match &self.body {
             Body::Corotated { reference, k } => {
                 let mut d = [0.0; 24];
@@ -142,14 +145,16 @@ impl Element {
                     }
                 };
                 reference.force(x, r, &mut d[..nd], local, f);
+                *state
             }
             Body::Tet(t) => {
                 let xs = [x[0], x[1], x[2], x[3]];
-                let fa = t.force(&xs);
+                let (fa, trial) = t.force(&xs, state);
                 f.fill(0.0);
                 for a in 0..4 {
                     f[6 * a..6 * a + 3].copy_from_slice(fa[a].as_slice());
                 }
+                trial
             }
         }
     }
@@ -172,6 +177,7 @@ impl Element {
         &self,
         x: &[Vector3<f64>],
         r: &[Matrix3<f64>],
+        state: &J2State3d,
         extra: Option<&LoadFn>,
     ) -> DMatrix<f64> {
         let n = x.len();
@@ -185,7 +191,7 @@ impl Element {
         let mut fp = vec![0.0; size];
         let mut tmp = vec![0.0; size];
         let mut eval = |xs: &[Vector3<f64>], rs: &[Matrix3<f64>], out: &mut [f64]| {
-            self.force(xs, rs, out);
+            self.force(xs, rs, state, out);
             if let Some(g) = extra {
                 g(xs, &mut tmp);
                 for (o, t) in out.iter_mut().zip(&tmp) {
@@ -224,7 +230,7 @@ impl Element {
     pub fn max_frequency_squared(&self, x0: &[Vector3<f64>], rot_mass: &[f64]) -> f64 {
         let n = x0.len();
         let ident = vec![Matrix3::identity(); n];
-        let k = self.tangent(x0, &ident, None);
+        let k = self.tangent(x0, &ident, &J2State3d::default(), None);
         let size = 6 * n;
         let minv: Vec<f64> = (0..size)
             .map(|i| {
