@@ -253,8 +253,7 @@ mod tests {
         child.wait().unwrap();
         assert!(!shm::run_files(&run_id).is_empty(), "a killed node leaves its files");
         assert!(!shm::run_has_live_node(&run_id));
-        // (A launcher opened by a concurrent test may have cleaned it already: either way it goes.)
-        shm::cleanup_stale_runs();
+        shm::cleanup_if_stale(&run_id, Duration::ZERO);
         assert!(shm::run_files(&run_id).is_empty());
         let _ = std::fs::remove_file(&out);
     }

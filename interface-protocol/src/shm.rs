@@ -122,14 +122,28 @@ pub fn run_has_live_node(run_id: &str) -> bool {
     alive || listed.is_err()
 }
 
-/// Removes the files of every run whose nodes are all dead (DESIGN §3: stale resources of dead
-/// runs are cleaned at start). Returns the run ids cleaned.
-pub fn cleanup_stale_runs() -> Vec<String> {
-    let mut cleaned = Vec::new();
-    for id in runs_on_disk() {
-        if !run_has_live_node(&id) && cleanup_run(&id).is_ok() {
-            cleaned.push(id);
-        }
-    }
-    cleaned
+/// A run whose files changed this recently may be starting up (its nodes not yet listed): it is
+/// never treated as stale.
+pub const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(30);
+
+/// Whether any file of the run was modified within `min_age` (or its age cannot be read).
+fn run_is_recent(run_id: &str, min_age: std::time::Duration) -> bool {
+    run_files(run_id).iter().any(|f| {
+        std::fs::symlink_metadata(f)
+            .and_then(|m| m.modified())
+            .map_or(true, |t| t.elapsed().map_or(true, |age| age < min_age))
+    })
+}
+
+/// Removes the files of every run whose nodes are all dead and whose files are older than
+/// `min_age` (DESIGN §3: stale resources of dead runs are cleaned at start; launchers pass
+/// `STALE_AFTER` so a concurrently starting run is safe). Returns the run ids cleaned.
+pub fn cleanup_stale_runs(min_age: std::time::Duration) -> Vec<String> {
+    runs_on_disk().into_iter().filter(|id| cleanup_if_stale(id, min_age)).collect()
+}
+
+/// Removes a run's files if all its nodes are dead and its files are older than `min_age`;
+/// returns whether it did.
+pub fn cleanup_if_stale(run_id: &str, min_age: std::time::Duration) -> bool {
+    !run_is_recent(run_id, min_age) && !run_has_live_node(run_id) && cleanup_run(run_id).is_ok()
 }

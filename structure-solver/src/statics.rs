@@ -149,7 +149,7 @@ pub fn load_steps(
     model: &mut dyn Model,
     targets: &[f64],
     s: &NewtonSettings,
-    mut on_step: impl FnMut(&dyn Model, Converged),
+    mut on_step: impl FnMut(&mut dyn Model, Converged),
 ) -> Result<Vec<Converged>, StaticsError> {
     let fd = FreeDofs::new(model);
     let n = model.n_dof();
@@ -168,7 +168,7 @@ pub fn load_steps(
                     t_now = t;
                     if t >= target - eps {
                         out.push(c);
-                        on_step(&*model, c);
+                        on_step(&mut *model, c);
                     }
                 }
                 Err(res) => {
@@ -252,7 +252,7 @@ pub fn displacement_control(
     control: usize,
     targets: &[f64],
     s: &NewtonSettings,
-    mut on_step: impl FnMut(&dyn Model, Converged),
+    mut on_step: impl FnMut(&mut dyn Model, Converged),
 ) -> Result<Vec<Converged>, StaticsError> {
     let fd = FreeDofs::new(model);
     let n = model.n_dof();
@@ -275,7 +275,7 @@ pub fn displacement_control(
                 let conv = Converged { t: lambda, iterations: it, residual: last };
                 model.commit();
                 out.push(conv);
-                on_step(&*model, conv);
+                on_step(&mut *model, conv);
                 ok = true;
                 break;
             }

@@ -57,7 +57,7 @@ impl LauncherLink {
     /// `timeouts.delivery` bounds the send of a command; waits take explicit deadlines.
     pub fn open(run_id: &str, timeouts: Timeouts) -> Result<LauncherLink, ProtocolError> {
         services::validate_run_id(run_id)?;
-        shm::cleanup_stale_runs();
+        shm::cleanup_stale_runs(shm::STALE_AFTER);
         let watch = Watch::signals_only();
         let node = services::node(run_id, services::LAUNCHER)?;
         let listener = event(&node, run_id, services::LAUNCHER)?

@@ -29,7 +29,7 @@ pub fn run_table(
     let targets: Vec<f64> = table.rows.iter().map(|r| r.0).collect();
     let s = NewtonSettings { tol: 1e-6, max_iter: 40, max_cuts: 10 };
     let mut got = Vec::new();
-    load_steps(model, &targets, &s, |m, _| got.push(measure(m)))
+    load_steps(model, &targets, &s, |m, _| got.push(measure(&*m)))
         .unwrap_or_else(|e| panic!("{}: {e}", table.name));
     println!("{}: P/Pmax, {:?} (computed / reference / relative error)", table.name, table.columns);
     let mut errors = Vec::new();
