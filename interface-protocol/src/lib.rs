@@ -19,5 +19,7 @@ pub mod participant;
 pub mod services;
 pub mod shm;
 
+#[cfg(feature = "cli")]
+pub mod cli;
 #[cfg(feature = "io")]
 pub mod io;

@@ -10,7 +10,7 @@ mod probes;
 mod solver;
 
 use clap::{Parser, Subcommand};
-use interface_protocol::case::Case;
+use interface_protocol::cli::RunArgs;
 use interface_protocol::endpoint::{StructureEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
 use interface_protocol::participant::serve;
@@ -31,23 +31,12 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run a case: coupled with --couple RUN_ID, alone (zero fluid load) otherwise.
-    Run {
-        case: PathBuf,
-        /// Join the coupled run RUN_ID started by the launcher.
-        #[arg(long)]
-        couple: Option<String>,
-        /// Output folder (default: the case's output.dir, else runs/<case>-rigid).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a case value, e.g. --set coupling.dt=1e-4.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-    },
+    Run(RunArgs),
 }
 
 fn main() -> ExitCode {
-    let Cmd::Run { case, couple, out, set } = Cli::parse().command;
-    match run(&case, couple.as_deref(), out, &set) {
+    let Cmd::Run(args) = Cli::parse().command;
+    match run(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
             eprintln!("rigid-structure: {message}");
@@ -56,18 +45,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(
-    case_path: &std::path::Path,
-    couple: Option<&str>,
-    out: Option<PathBuf>,
-    set: &[String],
-) -> Result<(), String> {
-    let case = Case::load(case_path, set).map_err(|e| e.to_string())?;
-    let out = out
-        .or_else(|| case.output.dir.as_ref().map(|d| case.dir().join(d)))
-        .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-rigid", case.case.name)));
+fn run(args: &RunArgs) -> Result<(), String> {
+    let case = args.load_case().map_err(|e| e.to_string())?;
+    let out =
+        args.out_dir(&case, || PathBuf::from("runs").join(format!("{}-rigid", case.case.name)));
     let mut solver = solver::RigidSolver::new(&case, out)?;
-    let Some(run_id) = couple else {
+    let Some(run_id) = args.couple.as_deref() else {
         let c = &case.coupling;
         return solver.run_alone(c.dt, c.n_steps(), c.t_end).map_err(|f| f.message);
     };

@@ -8,7 +8,8 @@
 //! <probe>.vy,<probe>.vz,<probe>.p`: the acoustic state at the face, ρ = ρ0 + (p - p0)/c0²).
 
 use clap::{Parser, Subcommand};
-use interface_protocol::case::{Case, PistonFluid};
+use interface_protocol::case::PistonFluid;
+use interface_protocol::cli::RunArgs;
 use interface_protocol::endpoint::{FluidEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
 use interface_protocol::messages::{Command, NodeLoad, NodeState, StepHeader};
@@ -28,16 +29,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run a case: coupled with --couple RUN_ID, alone (face at rest) otherwise.
-    Run {
-        case: PathBuf,
-        #[arg(long)]
-        couple: Option<String>,
-        /// Output folder (default: the case's output.dir, else runs/<case>-piston).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-    },
+    Run(RunArgs),
 }
 
 /// The face: its acoustic law and the probe file.
@@ -141,8 +133,8 @@ impl Handler<FluidEndpoint> for Piston {
 }
 
 fn main() -> ExitCode {
-    let Cmd::Run { case, couple, out, set } = Cli::parse().command;
-    match run(&case, couple.as_deref(), out, &set) {
+    let Cmd::Run(args) = Cli::parse().command;
+    match run(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
             eprintln!("piston-fluid: {message}");
@@ -151,21 +143,16 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(
-    case_path: &Path,
-    couple: Option<&str>,
-    out: Option<PathBuf>,
-    set: &[String],
-) -> Result<(), String> {
-    let case = Case::load(case_path, set).map_err(|e| e.to_string())?;
+fn run(args: &RunArgs) -> Result<(), String> {
+    let case = args.load_case().map_err(|e| e.to_string())?;
+    let case_path = &args.case;
     let law = case.fluid.as_ref().and_then(|f| f.piston.clone()).ok_or_else(|| {
         format!("{}: piston-fluid needs a [fluid.piston] section", case_path.display())
     })?;
-    let out = out
-        .or_else(|| case.output.dir.as_ref().map(|d| case.dir().join(d)))
-        .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-piston", case.case.name)));
+    let out =
+        args.out_dir(&case, || PathBuf::from("runs").join(format!("{}-piston", case.case.name)));
     let mut piston = Piston::new(law, &out)?;
-    let Some(run_id) = couple else {
+    let Some(run_id) = args.couple.as_deref() else {
         // Alone: the face at rest, the pressure p0 at every coupling time.
         let c = &case.coupling;
         let p = piston.pressure([0.0; 3]);
