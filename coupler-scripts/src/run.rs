@@ -359,17 +359,9 @@ impl Session<'_> {
             |p| format!("the {} participant {}", role.name(), p.label()),
         );
         loop {
-            match self.check_alive() {
-                Err(RunError::Died { death, .. }) => {
-                    let waiting = (death.role != role).then(|| format!("{who} to {what}"));
-                    return Err(RunError::Died { death, waiting });
-                }
-                other => other?,
-            }
+            // Read first, then look for deaths: a participant may answer and exit at once (after
+            // `Finish`), and its answer must not be lost to its exit.
             let now = Instant::now();
-            if now >= deadline {
-                return Err(RunError::Silent { who, what, timeout_s: self.timeout_s });
-            }
             let link = self.link.as_mut().expect("the link is open while waiting");
             match wait(link, (now + SLICE).min(deadline)) {
                 Ok(v) => return Ok(v),
@@ -378,6 +370,16 @@ impl Session<'_> {
                     return Err(RunError::Interrupted(signal))
                 }
                 Err(e) => return Err(e.into()),
+            }
+            match self.check_alive() {
+                Err(RunError::Died { death, .. }) => {
+                    let waiting = (death.role != role).then(|| format!("{who} to {what}"));
+                    return Err(RunError::Died { death, waiting });
+                }
+                other => other?,
+            }
+            if Instant::now() >= deadline {
+                return Err(RunError::Silent { who, what, timeout_s: self.timeout_s });
             }
         }
     }
