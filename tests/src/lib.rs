@@ -256,3 +256,60 @@ impl Probes {
 pub fn observed_orders(errors: &[f64]) -> Vec<f64> {
     errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
 }
+
+/// A mass on a spring and damper closing an acoustic column (`piston-fluid` coupled to
+/// `rigid-structure`, translation along x): m u'' + (c + A ρ0 c0) u' + k u = -A p0, from rest at
+/// u = 0 (DESIGN §8 item 7).
+#[derive(Debug, Clone, Copy)]
+pub struct Oscillator {
+    pub m: f64,
+    pub k: f64,
+    pub c: f64,
+    pub area: f64,
+    pub p0: f64,
+    pub rho0: f64,
+    pub c0: f64,
+}
+
+impl Oscillator {
+    /// The oscillator of a case's `[fluid.piston]` and one-dof `[structure.rigid]` sections.
+    pub fn from_case(case: &interface_protocol::case::Case) -> Oscillator {
+        let piston = case.fluid.as_ref().and_then(|f| f.piston.clone()).expect("[fluid.piston]");
+        let body =
+            case.structure.as_ref().and_then(|s| s.rigid.clone()).expect("[structure.rigid]");
+        assert_eq!(body.dofs, ["x"], "a one-dof body along x");
+        let one = |v: &interface_protocol::case::PerDof| v.values(1).expect("one value")[0];
+        assert_eq!((one(&body.u0), one(&body.v0)), (0.0, 0.0), "a body starting at rest");
+        Oscillator {
+            m: body.mass,
+            k: one(&body.stiffness),
+            c: one(&body.damping),
+            area: piston.area,
+            p0: piston.p0,
+            rho0: piston.rho0,
+            c0: piston.c0,
+        }
+    }
+
+    /// Exact displacement: u_s + e^{-γt} (C1 cos ω_d t + C2 sin ω_d t), with the static offset
+    /// u_s = -A p0 / k, γ = (c + A ρ0 c0) / 2m, ω_d = sqrt(k/m - γ²) (underdamped).
+    pub fn displacement(&self, t: f64) -> f64 {
+        let u_s = -self.area * self.p0 / self.k;
+        let gamma = (self.c + self.area * self.rho0 * self.c0) / (2.0 * self.m);
+        let wd = (self.k / self.m - gamma * gamma).sqrt();
+        let (c1, c2) = (-u_s, -gamma * u_s / wd);
+        u_s + (-gamma * t).exp() * (c1 * (wd * t).cos() + c2 * (wd * t).sin())
+    }
+
+    /// Largest |u - u_exact| of the probe `<probe>.ux` in a run folder's `structure_probes.csv`,
+    /// relative to the static offset A p0 / k; checks the run reached `t_end`.
+    pub fn max_error(&self, out: &Path, probe: &str, t_end: f64) -> f64 {
+        let probes = Probes::read(&out.join("structure_probes.csv"));
+        let series = probes.series(&format!("{probe}.ux"));
+        assert!(series.len() >= 10, "only {} probe rows in {}", series.len(), out.display());
+        let last = series.last().unwrap().0;
+        assert!((last - t_end).abs() < 1e-9, "the run ended at t = {last}, not {t_end}");
+        let scale = self.area * self.p0 / self.k;
+        series.iter().map(|&(t, u)| (u - self.displacement(t)).abs()).fold(0.0, f64::max) / scale
+    }
+}

@@ -4,21 +4,8 @@
 //! `structure_probes.csv` is compared with; the error over three step sizes gives each scheme's
 //! observed temporal order (DESIGN §4, §8 item 7).
 
-use fsi_system_tests::{observed_orders, Fsi, Probes, Scratch};
-use std::path::Path;
+use fsi_system_tests::{observed_orders, Fsi, Oscillator, Scratch};
 use std::time::Duration;
-
-/// The oscillator: mass, spring, damper, piston face and column.
-#[derive(Debug, Clone, Copy)]
-struct Oscillator {
-    m: f64,
-    k: f64,
-    c: f64,
-    area: f64,
-    p0: f64,
-    rho0: f64,
-    c0: f64,
-}
 
 const OSC: Oscillator =
     Oscillator { m: 1.0, k: 3947.8, c: 2.0, area: 1e-3, p0: 1e5, rho0: 1.2, c0: 340.0 };
@@ -26,20 +13,10 @@ const OSC: Oscillator =
 /// One period of the 10 Hz spring.
 const T_END: f64 = 0.1;
 
-impl Oscillator {
-    /// Exact displacement from rest at u = 0: u_s + e^{-γt} (C1 cos ω_d t + C2 sin ω_d t), with
-    /// the static offset u_s = -A p0 / k, γ = (c + A ρ0 c0) / 2m, ω_d = sqrt(k/m - γ²).
-    fn displacement(&self, t: f64) -> f64 {
-        let u_s = -self.area * self.p0 / self.k;
-        let gamma = (self.c + self.area * self.rho0 * self.c0) / (2.0 * self.m);
-        let wd = (self.k / self.m - gamma * gamma).sqrt();
-        let (c1, c2) = (-u_s, -gamma * u_s / wd);
-        u_s + (-gamma * t).exp() * (c1 * (wd * t).cos() + c2 * (wd * t).sin())
-    }
-
-    fn case(&self, scheme: &str, dt: f64) -> String {
-        format!(
-            r#"[case]
+/// The case text of `o` coupled with `scheme` at step `dt`.
+fn case(o: &Oscillator, scheme: &str, dt: f64) -> String {
+    format!(
+        r#"[case]
 name = "oscillator"
 [coupling]
 scheme = "{scheme}"
@@ -61,33 +38,20 @@ stiffness = {}
 damping = {}
 probe = "piston"
 "#,
-            self.area, self.p0, self.rho0, self.c0, self.m, self.k, self.c
-        )
-    }
-
-    /// Largest |u - u_exact| over the probe rows of a run folder, relative to the static offset.
-    fn error(&self, out: &Path) -> f64 {
-        let probes = Probes::read(&out.join("structure_probes.csv"));
-        let series = probes.series("piston.ux");
-        assert!(series.len() >= 10, "only {} probe rows in {}", series.len(), out.display());
-        let last = series.last().unwrap().0;
-        assert!((last - T_END).abs() < 1e-9, "the run ended at t = {last}, not {T_END}");
-        let scale = self.area * self.p0 / self.k;
-        series.iter().map(|&(t, u)| (u - self.displacement(t)).abs()).fold(0.0, f64::max) / scale
-    }
+        o.area, o.p0, o.rho0, o.c0, o.m, o.k, o.c
+    )
 }
-
 /// Runs `scheme` at dt, dt/2, dt/4 and returns the relative errors.
 fn errors(scheme: &str, dts: &[f64]) -> Vec<f64> {
     let scratch = Scratch::new();
     dts.iter()
         .map(|&dt| {
             let case =
-                scratch.case(&format!("{scheme}-{}", (1.0 / dt).round()), &OSC.case(scheme, dt));
+                scratch.case(&format!("{scheme}-{}", (1.0 / dt).round()), &case(&OSC, scheme, dt));
             let out = scratch.path().join(format!("out-{}", (1.0 / dt).round()));
             let done = Fsi::run(&scratch, &case, &out, &[]).wait(Duration::from_secs(20));
             assert!(done.status.success(), "fsi run {scheme} dt {dt} failed:\n{}", done.stderr);
-            OSC.error(&out)
+            OSC.max_error(&out, "piston", T_END)
         })
         .collect()
 }
@@ -149,7 +113,7 @@ fn concurrent_runs_do_not_see_each_others_data() {
     let runs: Vec<_> = [("low", low), ("high", high)]
         .iter()
         .map(|(name, o)| {
-            let case = scratch.case(name, &o.case("C0", dt));
+            let case = scratch.case(name, &case(o, "C0", dt));
             let out = scratch.path().join(name);
             (Fsi::run(&scratch, &case, &out, &[]), out, *o)
         })
@@ -157,7 +121,7 @@ fn concurrent_runs_do_not_see_each_others_data() {
     for (fsi, out, o) in runs {
         let done = fsi.wait(Duration::from_secs(20));
         assert!(done.status.success(), "{}", done.stderr);
-        let e = o.error(&out);
+        let e = o.max_error(&out, "piston", T_END);
         println!("concurrent run p0 = {:e}: relative error {e:.3e}", o.p0);
         // A mixed-up load would be off by the ratio of the pressures (3x), an O(1) error.
         assert!(e < 1e-2, "p0 = {}: relative error {e}", o.p0);
