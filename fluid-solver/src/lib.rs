@@ -5,12 +5,13 @@
 //! Modules follow the discretisation: `eos` -> `mesh` (geometry and connectivity only, never
 //! solver state) -> `riemann`, `flux`, `reconstruct`, `bc` -> `state`, `initial` ->
 //! `semidiscretization` (the residual) -> `time` -> `solver` (the run loop) with `output`,
-//! `probes`. Must not touch: the structure, the IPC transport (it talks to the structure only
-//! through `interface-protocol` endpoints).
+//! `probes` -> `couple` (the coupling participant). Must not touch: the structure, the IPC
+//! transport (it talks to the structure only through `interface-protocol` endpoints).
 #![deny(unsafe_op_in_unsafe_fn)]
 
 pub mod bc;
 pub mod bench;
+pub mod couple;
 pub mod eos;
 pub mod flux;
 pub mod initial;

@@ -1,7 +1,8 @@
-//! `fluid-solver`: runs a case alone (`run`), or measures its speed (`bench`).
+//! `fluid-solver`: runs a case alone (`run`) or as the fluid of a coupled run (`run --couple`),
+//! or measures its speed (`bench`).
 
 use clap::{Parser, Subcommand};
-use fluid_solver::{bench, solver};
+use fluid_solver::{bench, couple, solver};
 use interface_protocol::cli::RunArgs;
 use interface_protocol::io::outdir;
 use std::path::PathBuf;
@@ -21,7 +22,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a case's fluid alone.
+    /// Run a case's fluid: alone, or coupled with --couple RUN_ID (started by `fsi run`).
     Run {
         #[command(flatten)]
         args: RunArgs,
@@ -46,15 +47,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { args, restart, force } => {
-            if args.couple.is_some() {
-                Err(anyhow::anyhow!(
-                    "coupling not available: this build of fluid-solver runs cases alone (drop --couple)"
-                ))
-            } else {
-                run(&args, restart, force)
-            }
-        }
+        Command::Run { args, restart, force } => run(&args, restart, force),
         Command::Bench { nodes, steps } => bench::run(nodes, steps).map(|report| {
             println!("{}", serde_json::to_string_pretty(&report).expect("JSON"));
         }),
@@ -74,6 +67,9 @@ fn run(args: &RunArgs, restart: Option<PathBuf>, force: bool) -> anyhow::Result<
     let out = args.out_dir(&case, || outdir::default_run_dir(&args.case, SystemTime::now()));
     let quiet = args.quiet;
     let opts = solver::RunOptions { out: out.clone(), quiet, restart, force };
+    if let Some(run_id) = &args.couple {
+        return couple::run(&case, &text, opts, run_id);
+    }
     let summary = solver::run(&case, &text, &opts)?;
     if !quiet {
         eprintln!(

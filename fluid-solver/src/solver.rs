@@ -1,17 +1,18 @@
-//! The stand-alone run loop (DESIGN §7): march a case to its end time with RK2, writing probes,
-//! lines, the field time series, checkpoints and `run.json`; restart from a checkpoint; stop at
-//! the first invalid or non-finite state naming node, time and values, keeping the last good
-//! checkpoint.
+//! The run loop (DESIGN §7): [`FluidRun`] marches a case with RK2 in CFL steps, writing probes,
+//! lines, the field time series and checkpoints. [`run`] drives it alone to its end time and
+//! writes `run.json`; [`crate::couple`] drives it from the coupling commands. Restarts from a
+//! checkpoint; stops at the first invalid or non-finite state naming node, time and values,
+//! keeping the last good checkpoint.
 //!
 //! A restarted run is bitwise identical to an uninterrupted one: the state is the conserved
-//! array plus `(step, t)`, and the time step depends only on them and on `t_end`.
+//! array plus `(step, t)`, and the time step depends only on them and on the target time.
 
 use crate::output;
 use crate::probes::{nearest_node, Line};
 use crate::semidiscretization::Semidiscretization;
 use crate::setup::{self, Problem};
 use crate::state::{State, Workspace};
-use crate::time::rk2_step;
+use crate::time::{rk2_step, TimeStepping};
 use anyhow::Context;
 use interface_protocol::case::Case;
 use interface_protocol::io::checkpoint::{self, Checkpoint};
@@ -20,6 +21,7 @@ use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::{write_line_sample, ProbeWriter};
 use interface_protocol::io::progress::Progress;
 use interface_protocol::io::report::{self, bucket, RunReport, Timers};
+use interface_protocol::io::xdmf::TimeSeriesWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -61,121 +63,290 @@ pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State,
     Ok((State { cons }, ck.step, ck.time))
 }
 
-fn write_checkpoint(out: &OutputDir, state: &State, step: u64, time: f64) -> anyhow::Result<()> {
-    let mut ck = Checkpoint::new(step, time);
-    ck.put_f64_n("cons", &state.cons)?;
-    ck.write(&out.checkpoints()?, &checkpoint::tag_for_step(step), CHECKPOINT_PART)?;
-    Ok(())
+/// Whether the fluid runs alone or as a participant of a coupled run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Alone: creates its output folder, draws a progress bar, stops at `fluid.time.t_end` or
+    /// `max_steps`, checkpoints every `output.checkpoint_every` steps and writes `run.json`.
+    Alone,
+    /// Coupled (DESIGN §7): the launcher made the output folder, drives the time with its
+    /// `Advance` commands, asks for checkpoints and writes `run.json` itself.
+    Coupled,
 }
 
-/// Runs a case alone. `case_text` is echoed into `run.json`.
-pub fn run(case: &Case, case_text: &str, opts: &RunOptions) -> anyhow::Result<RunSummary> {
-    let wall = Instant::now();
-    let problem = setup::problem(case)?;
-    let out = OutputDir::create(&opts.out, Policy::from_force(opts.force))?;
-    let mut timers = Timers::new();
-    let Problem { semi, initial, stepping, t_end, max_steps, probes, lines } = problem;
-    let (mut state, mut step, mut t) = match &opts.restart {
-        Some(dir) => read_checkpoint(dir, semi.mesh.n_nodes())?,
-        None => (initial, 0, 0.0),
-    };
-    let every = &case.output;
-    let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
-    semi.primitives(&state.cons, &mut ws)?;
+/// Where an advance ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reached {
+    /// Fluid (CFL) steps taken since the start of the run.
+    pub step: u64,
+    /// Time reached.
+    pub t: f64,
+}
 
-    let mut fields = output::create_writer(out.path(), &semi.mesh)?;
-    let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
-    let probe_nodes: Vec<usize> = probes.iter().map(|p| nearest_node(&semi.mesh, p.at)).collect();
-    let mut probe_csv = ProbeWriter::fluid(out.path(), &names)?;
-    let mut lines: Vec<Line> = lines
-        .iter()
-        .map(|l| Line::new(&semi.mesh, &l.name, l.from, l.to, l.points, &l.times))
-        .collect();
-    let write_probes = |csv: &mut ProbeWriter, t: f64, prim: &[[f64; 5]]| {
-        let row: Vec<f64> = probe_nodes.iter().flat_map(|&i| prim[i]).collect();
-        csv.write_row(t, &row)
-    };
-    write_probes(&mut probe_csv, t, &ws.prim)?;
-    output::write_fields(&mut fields, &semi.eos, t, &ws.prim)?;
+/// One fluid run: the state and every open output, advanced by [`FluidRun::advance_to`] in
+/// CFL-limited RK2 steps. The stand-alone loop ([`run`]) and the coupled participant share it.
+pub struct FluidRun<'a> {
+    case: &'a Case,
+    case_text: &'a str,
+    mode: Mode,
+    wall: Instant,
+    out: OutputDir,
+    timers: Timers,
+    semi: Semidiscretization,
+    stepping: TimeStepping,
+    t_end: f64,
+    max_steps: Option<u64>,
+    state: State,
+    ws: Workspace,
+    step: u64,
+    t: f64,
+    fields: TimeSeriesWriter,
+    probe_nodes: Vec<usize>,
+    probe_csv: ProbeWriter,
+    lines: Vec<Line>,
+    last_fields_step: u64,
+    bar: Option<Progress>,
+    /// `Err` once a step failed: the run stops there and reports it.
+    status: Result<(), String>,
+}
 
-    let mut bar = Progress::new(t_end, opts.quiet);
-    let mut status = Ok(());
-    let mut last_fields_step = step;
-    while t < t_end * (1.0 - 1e-12) && max_steps.is_none_or(|m| step < m) {
-        let start = Instant::now();
-        let result = rk2_step(&semi, &mut state, &mut ws, stepping, t_end - t);
-        timers.add_since(bucket::RESIDUAL, start);
-        let dt = match result {
-            Ok(dt) => dt,
-            Err(e) => {
-                // The state is unchanged by a failed step: keep it as the last good checkpoint.
-                write_checkpoint(&out, &state, step, t)?;
-                status = Err(format!("stopped at step {}, t = {t:e}: {e}", step + 1));
-                break;
-            }
+impl<'a> FluidRun<'a> {
+    /// Sets the case up, opens the outputs and writes the initial probes and fields.
+    /// `case_text` is echoed into `run.json`.
+    pub fn open(
+        case: &'a Case,
+        case_text: &'a str,
+        opts: &RunOptions,
+        mode: Mode,
+    ) -> anyhow::Result<FluidRun<'a>> {
+        let wall = Instant::now();
+        let problem = setup::problem(case)?;
+        let policy = match mode {
+            Mode::Alone => Policy::from_force(opts.force),
+            Mode::Coupled => Policy::Existing,
         };
-        if let Err(e) =
-            check_finite("conserved [ρ, ρu, ρv, ρw, E]", Entity::Node, t + dt, &state.cons[..])
-        {
-            let node = e.index;
-            status = Err(format!(
-                "stopped at step {}: {e} (x = {:?}, conserved = {:?}); the last good checkpoint is kept",
-                step + 1,
-                semi.mesh.coords[node],
-                state.cons[node]
-            ));
-            break;
+        let out = OutputDir::create(&opts.out, policy)?;
+        let Problem { semi, initial, stepping, t_end, max_steps, probes, lines } = problem;
+        let (state, step, t) = match &opts.restart {
+            Some(dir) => read_checkpoint(dir, semi.mesh.n_nodes())?,
+            None => (initial, 0, 0.0),
+        };
+        let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+        semi.primitives(&state.cons, &mut ws)?;
+
+        let mut fields = output::create_writer(out.path(), &semi.mesh)?;
+        let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
+        let probe_nodes: Vec<usize> =
+            probes.iter().map(|p| nearest_node(&semi.mesh, p.at)).collect();
+        let probe_csv = ProbeWriter::fluid(out.path(), &names)?;
+        let lines: Vec<Line> = lines
+            .iter()
+            .map(|l| Line::new(&semi.mesh, &l.name, l.from, l.to, l.points, &l.times))
+            .collect();
+        output::write_fields(&mut fields, &semi.eos, t, &ws.prim)?;
+        let bar = Progress::new(t_end, opts.quiet || mode == Mode::Coupled);
+        let mut run = FluidRun {
+            case,
+            case_text,
+            mode,
+            wall,
+            out,
+            timers: Timers::new(),
+            semi,
+            stepping,
+            t_end,
+            max_steps,
+            state,
+            ws,
+            step,
+            t,
+            fields,
+            probe_nodes,
+            probe_csv,
+            lines,
+            last_fields_step: step,
+            bar: Some(bar),
+            status: Ok(()),
+        };
+        run.write_probes()?;
+        Ok(run)
+    }
+
+    /// `fluid.time.t_end` of the case (the end of a stand-alone run).
+    pub fn t_end(&self) -> f64 {
+        self.t_end
+    }
+
+    /// Where the run stands.
+    pub fn reached(&self) -> Reached {
+        Reached { step: self.step, t: self.t }
+    }
+
+    /// The mesh, EOS and scheme.
+    pub fn semidiscretization(&self) -> &Semidiscretization {
+        &self.semi
+    }
+
+    fn write_probes(&mut self) -> anyhow::Result<()> {
+        let prim = &self.ws.prim;
+        let row: Vec<f64> = self.probe_nodes.iter().flat_map(|&i| prim[i]).collect();
+        self.probe_csv.write_row(self.t, &row)?;
+        Ok(())
+    }
+
+    /// Advances to `t_target` in RK2 steps of the CFL step, the last one clipped to land on
+    /// `t_target`, writing the outputs of every step; stops early after `fluid.time.max_steps`
+    /// steps (stand-alone runs only). A failed step keeps the last good state as a checkpoint and
+    /// returns the error naming the step, time, node and values; the run then only finishes.
+    pub fn advance_to(&mut self, t_target: f64) -> anyhow::Result<Reached> {
+        if let Err(e) = &self.status {
+            anyhow::bail!("{e}");
         }
-        t += dt;
-        step += 1;
-        let start = Instant::now();
-        let want_fields = every.fields_every > 0 && step % every.fields_every == 0;
-        let want_lines = lines.iter().any(|l| l.pending.first().is_some_and(|&lt| t >= lt));
-        if step % every.probes_every == 0 || want_fields || want_lines {
-            semi.primitives(&state.cons, &mut ws)?;
-        }
-        if step % every.probes_every == 0 {
-            write_probes(&mut probe_csv, t, &ws.prim)?;
-        }
-        if want_fields {
-            output::write_fields(&mut fields, &semi.eos, t, &ws.prim)?;
-            last_fields_step = step;
-        }
-        for line in &mut lines {
-            if line.pending.first().is_some_and(|&lt| t >= lt) {
-                while line.pending.first().is_some_and(|&lt| t >= lt) {
-                    line.pending.remove(0);
+        let limit = match self.mode {
+            Mode::Alone => self.max_steps,
+            Mode::Coupled => None,
+        };
+        let every = &self.case.output;
+        while self.t < t_target * (1.0 - 1e-12) && limit.is_none_or(|m| self.step < m) {
+            let (step, t) = (self.step, self.t);
+            let start = Instant::now();
+            let result =
+                rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, t_target - t);
+            self.timers.add_since(bucket::RESIDUAL, start);
+            let dt = match result {
+                Ok(dt) => dt,
+                Err(e) => {
+                    // The state is unchanged by a failed step: keep it as the last good checkpoint.
+                    self.write_checkpoint(&checkpoint::tag_for_step(step))?;
+                    return self.fail(format!("stopped at step {}, t = {t:e}: {e}", step + 1));
                 }
-                let name = format!("{}_t{t:.6e}", line.name);
-                write_line_sample(&out.lines()?, &name, &line.sample(&ws.prim))?;
+            };
+            let cons = &self.state.cons[..];
+            if let Err(e) = check_finite("conserved [ρ, ρu, ρv, ρw, E]", Entity::Node, t + dt, cons)
+            {
+                let node = e.index;
+                return self.fail(format!(
+                    "stopped at step {}: {e} (x = {:?}, conserved = {:?}); the last good checkpoint is kept",
+                    step + 1,
+                    self.semi.mesh.coords[node],
+                    self.state.cons[node]
+                ));
+            }
+            self.t += dt;
+            self.step += 1;
+            let (step, t) = (self.step, self.t);
+            let start = Instant::now();
+            let want_fields = every.fields_every > 0 && step % every.fields_every == 0;
+            let want_lines =
+                self.lines.iter().any(|l| l.pending.first().is_some_and(|&lt| t >= lt));
+            if step % every.probes_every == 0 || want_fields || want_lines {
+                self.semi.primitives(&self.state.cons, &mut self.ws)?;
+            }
+            if step % every.probes_every == 0 {
+                self.write_probes()?;
+            }
+            if want_fields {
+                output::write_fields(&mut self.fields, &self.semi.eos, t, &self.ws.prim)?;
+                self.last_fields_step = step;
+            }
+            for line in &mut self.lines {
+                if line.pending.first().is_some_and(|&lt| t >= lt) {
+                    while line.pending.first().is_some_and(|&lt| t >= lt) {
+                        line.pending.remove(0);
+                    }
+                    let name = format!("{}_t{t:.6e}", line.name);
+                    write_line_sample(&self.out.lines()?, &name, &line.sample(&self.ws.prim))?;
+                }
+            }
+            if self.mode == Mode::Alone
+                && every.checkpoint_every > 0
+                && step % every.checkpoint_every == 0
+            {
+                self.write_checkpoint(&checkpoint::tag_for_step(step))?;
+            }
+            self.timers.add_since(bucket::OUTPUT, start);
+            if let Some(bar) = &mut self.bar {
+                bar.update(step, t, dt);
             }
         }
-        if every.checkpoint_every > 0 && step % every.checkpoint_every == 0 {
-            write_checkpoint(&out, &state, step, t)?;
-        }
-        timers.add_since(bucket::OUTPUT, start);
-        bar.update(step, t, dt);
+        Ok(self.reached())
     }
-    bar.finish();
-    if status.is_ok() {
+
+    fn fail(&mut self, message: String) -> anyhow::Result<Reached> {
+        self.status = Err(message.clone());
+        Err(anyhow::anyhow!(message))
+    }
+
+    /// Whether a step failed (the run can then only finish).
+    pub fn failed(&self) -> bool {
+        self.status.is_err()
+    }
+
+    /// Writes the conserved state as the checkpoint `tag` (part [`CHECKPOINT_PART`]).
+    pub fn write_checkpoint(&mut self, tag: &str) -> anyhow::Result<()> {
         let start = Instant::now();
-        semi.primitives(&state.cons, &mut ws)?;
-        if last_fields_step != step {
-            output::write_fields(&mut fields, &semi.eos, t, &ws.prim)?;
-        }
-        for line in &lines {
-            write_line_sample(&out.lines()?, &line.name, &line.sample(&ws.prim))?;
-        }
-        write_checkpoint(&out, &state, step, t)?;
-        timers.add_since(bucket::OUTPUT, start);
+        let mut ck = Checkpoint::new(self.step, self.t);
+        ck.put_f64_n("cons", &self.state.cons)?;
+        ck.write(&self.out.checkpoints()?, tag, CHECKPOINT_PART)?;
+        self.timers.add_since(bucket::OUTPUT, start);
+        Ok(())
     }
-    probe_csv.flush()?;
-    fields.finish()?;
-    write_report(case, case_text, &out, &semi, &status, step, t, &timers, wall)?;
-    match status {
-        Ok(()) => Ok(RunSummary { steps: step, time: t, nodes: semi.mesh.n_nodes() }),
-        Err(e) => Err(anyhow::anyhow!(e)),
+
+    /// Writes the final fields and lines (and, alone, the final checkpoint and `run.json`) and
+    /// closes the files. Returns the failure of a failed run.
+    pub fn finish(mut self) -> anyhow::Result<RunSummary> {
+        if let Some(bar) = self.bar.take() {
+            bar.finish();
+        }
+        if self.status.is_ok() {
+            let start = Instant::now();
+            self.semi.primitives(&self.state.cons, &mut self.ws)?;
+            if self.last_fields_step != self.step {
+                output::write_fields(&mut self.fields, &self.semi.eos, self.t, &self.ws.prim)?;
+            }
+            for line in &self.lines {
+                write_line_sample(&self.out.lines()?, &line.name, &line.sample(&self.ws.prim))?;
+            }
+            self.timers.add_since(bucket::OUTPUT, start);
+            if self.mode == Mode::Alone {
+                self.write_checkpoint(&checkpoint::tag_for_step(self.step))?;
+            }
+        }
+        self.probe_csv.flush()?;
+        self.fields.finish()?;
+        if self.mode == Mode::Alone {
+            write_report(
+                self.case,
+                self.case_text,
+                &self.out,
+                &self.semi,
+                &self.status,
+                self.step,
+                self.t,
+                &self.timers,
+                self.wall,
+            )?;
+        }
+        match self.status {
+            Ok(()) => {
+                Ok(RunSummary { steps: self.step, time: self.t, nodes: self.semi.mesh.n_nodes() })
+            }
+            Err(e) => Err(anyhow::anyhow!(e)),
+        }
     }
+}
+
+/// Runs a case alone to `fluid.time.t_end` (or `max_steps`). `case_text` is echoed into
+/// `run.json`.
+pub fn run(case: &Case, case_text: &str, opts: &RunOptions) -> anyhow::Result<RunSummary> {
+    let mut run = FluidRun::open(case, case_text, opts, Mode::Alone)?;
+    let t_end = run.t_end();
+    if let Err(e) = run.advance_to(t_end) {
+        if !run.failed() {
+            return Err(e);
+        }
+    }
+    run.finish()
 }
 
 fn write_report(

@@ -1,0 +1,278 @@
+//! `fluid-solver run --couple`: the fluid as a protocol participant. Without an embedded boundary
+//! (thesis Ch. 4-5) it couples only to a structure without a wet surface: such a run advances the
+//! fluid over the coupling steps exactly as the stand-alone stepper does with the same targets,
+//! and a structure with a wet surface is refused at `Init` with a message naming the reason.
+//!
+//! `rigid-structure` requires at least one wet node, so the structure without a wet surface is
+//! played here by the test itself, which is also the launcher. The refusal runs through `fsi`;
+//! build the binaries first: `cargo build --release -p coupler-scripts -p rigid-structure -p
+//! fluid-solver --bins`.
+
+mod common;
+
+use common::ExactTube;
+use fluid_solver::couple::no_embedded_boundary;
+use fluid_solver::eos::Eos;
+use fluid_solver::solver::{FluidRun, Mode, RunOptions};
+use interface_protocol::case::Case;
+use interface_protocol::endpoint::{LauncherLink, StructureEndpoint, Timeouts};
+use interface_protocol::handshake::HelloInfo;
+use interface_protocol::io::checkpoint::Checkpoint;
+use interface_protocol::liveness::LAUNCHER_PID_ENV;
+use interface_protocol::messages::{reply_kind, scheme_phase, Command, Reply, Role, StepHeader};
+use interface_protocol::participant::failure_code;
+use std::path::{Path, PathBuf};
+use std::process::{Command as Process, Stdio};
+use std::time::{Duration, Instant};
+
+/// Sod's tube (`cases/sod-tube`, 50 cells, to t = 0.1) coupled with CSS in four steps.
+const FLUID: &str = r#"
+[case]
+name = "sod-coupled"
+
+[coupling]
+scheme = "CSS"
+dt = 0.025
+t_end = 0.1
+timeout_s = 10.0
+
+[fluid]
+command = ["fluid-solver"]
+eos = { kind = "perfect_gas", gamma = 1.4 }
+probes = [
+  { name = "left", at = [0.2, 0.0, 0.0] },
+  { name = "right", at = [0.8, 0.0, 0.0] },
+]
+lines = [{ name = "axis", from = [0.0, 0.0, 0.0], to = [1.0, 0.0, 0.0], points = 51, times = [0.05] }]
+
+[fluid.mesh]
+box = { lo = [0.0, 0.0, 0.0], hi = [1.0, 0.02, 0.02], cells = [50, 1, 1], shape = "tet" }
+
+[fluid.initial]
+state = [1.0, 0.0, 0.0, 0.0, 1.0]
+regions = [
+  { region = { shape = "half_space", point = [0.3, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }, state = [0.125, 0.0, 0.0, 0.0, 0.1] },
+]
+
+[fluid.boundary]
+xmin = { kind = "far_field", state = [1.0, 0.0, 0.0, 0.0, 1.0] }
+xmax = { kind = "far_field", state = [0.125, 0.0, 0.0, 0.0, 0.1] }
+ymin = { kind = "symmetry" }
+ymax = { kind = "symmetry" }
+zmin = { kind = "symmetry" }
+zmax = { kind = "symmetry" }
+
+[fluid.numerics]
+flux = "roe"
+limiter = "van_albada"
+cfl = 0.9
+
+[fluid.time]
+t_end = 0.1
+
+[output]
+fields_every = 10
+probes_every = 1
+"#;
+
+/// A rigid piston with a wet square of four nodes.
+const WET_STRUCTURE: &str = r#"
+[structure]
+command = ["rigid-structure"]
+
+[structure.rigid]
+mass = 1.0
+stiffness = 1.0e4
+wet_nodes = [[0.0, -0.1, -0.1], [0.0, 0.1, -0.1], [0.0, 0.1, 0.1], [0.0, -0.1, 0.1]]
+wet_elements = [[0, 1, 2, 3]]
+"#;
+
+/// The coupling times t^n of `FLUID`.
+const TIMES: [f64; 5] = [0.0, 0.025, 0.05, 0.075, 0.1];
+
+fn write_case(dir: &Path, text: &str) -> PathBuf {
+    let path = dir.join("case.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A run id no other test uses.
+fn run_id(tag: &str) -> String {
+    format!("fs{:x}-{tag}", std::process::id())
+}
+
+/// The workspace binary `name`, next to `fluid-solver` in `target/<profile>`.
+fn bin(name: &str) -> PathBuf {
+    let p = Path::new(env!("CARGO_BIN_EXE_fluid-solver")).with_file_name(name);
+    assert!(
+        p.is_file(),
+        "{} is missing: build first with `cargo build{} -p coupler-scripts -p rigid-structure -p \
+         fluid-solver --bins`",
+        p.display(),
+        if cfg!(debug_assertions) { "" } else { " --release" }
+    );
+    p
+}
+
+fn expect_reply(link: &mut LauncherLink, command: &Command, kind: u32) -> Reply {
+    link.send(Role::Fluid, command).unwrap();
+    let reply = link.wait_reply(Role::Fluid, Instant::now() + Duration::from_secs(10)).unwrap();
+    assert_eq!(
+        reply.kind,
+        kind,
+        "{} answered with kind {} (code {}): {}",
+        command.describe(),
+        reply.kind,
+        reply.code,
+        reply.message_str()
+    );
+    reply
+}
+
+fn header(step: u64, time: f64) -> StepHeader {
+    StepHeader { step, time, dt: 0.025, topology_version: 1, count: 0 }
+}
+
+/// Rows of a CSV file as numbers (header skipped).
+fn rows(path: &Path) -> Vec<Vec<f64>> {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|s| s.parse().unwrap()).collect())
+        .collect()
+}
+
+fn assert_same_rows(a: &Path, b: &Path) {
+    let (ra, rb) = (rows(a), rows(b));
+    assert_eq!(ra.len(), rb.len(), "{} vs {}", a.display(), b.display());
+    for (x, y) in ra.iter().flatten().zip(rb.iter().flatten()) {
+        assert!((x - y).abs() <= 1e-12 * x.abs().max(y.abs()), "{}: {x} vs {y}", a.display());
+    }
+}
+
+#[test]
+fn a_coupled_run_without_wet_surface_steps_like_the_fluid_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let case_path = write_case(dir.path(), FLUID);
+    let case = Case::load(&case_path, &[]).unwrap();
+    let coupled = dir.path().join("coupled");
+    std::fs::create_dir(&coupled).unwrap();
+    let id = run_id("empty");
+    let timeouts = Timeouts::from_secs(10.0);
+
+    // The launcher and a structure without a wet surface, both played here.
+    let mut link = LauncherLink::open(&id, timeouts).unwrap();
+    let fluid = Process::new(bin("fluid-solver"))
+        .arg("run")
+        .arg(&case_path)
+        .args(["--couple", &id, "--quiet", "--out"])
+        .arg(&coupled)
+        .env(LAUNCHER_PID_ENV, std::process::id().to_string())
+        .stdin(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
+    let mut structure = StructureEndpoint::open(&id, info, timeouts).unwrap();
+    let soon = Instant::now() + Duration::from_secs(10);
+    let f = link.wait_hello(Role::Fluid, soon).unwrap();
+    let s = link.wait_hello(Role::Structure, soon).unwrap();
+    assert_eq!((f.n_surface_nodes, f.n_surface_elements), (0, 0), "the fluid accepts any count");
+    LauncherLink::check(&f, &s, case.hash()).unwrap();
+
+    structure.publish_topology(header(0, 0.0), 0, |_| ()).unwrap();
+    structure.publish_kinematics(header(0, 0.0), 0, |_| ()).unwrap();
+    let ready = expect_reply(&mut link, &Command::init(), reply_kind::READY);
+    assert_eq!(ready.dt_stable, f64::INFINITY);
+    let (t0, n0) = structure.read_loads(|h, loads| (h.time, loads.len())).unwrap();
+    assert_eq!((t0, n0), (0.0, 0));
+    for (n, w) in TIMES.windows(2).enumerate() {
+        let n = n as u64;
+        structure.publish_kinematics(header(n, w[1]), 0, |_| ()).unwrap();
+        let command = Command::advance(n, w[0], w[1], scheme_phase::NONE);
+        let done = expect_reply(&mut link, &command, reply_kind::DONE);
+        assert_eq!((done.step, done.t), (n, w[1]));
+        let (t, count) = structure.read_loads(|h, loads| (h.time, loads.len())).unwrap();
+        assert_eq!((t, count), (w[1], 0), "the loads at t_to on no wet node");
+        if n == 1 {
+            expect_reply(&mut link, &Command::checkpoint("step-2"), reply_kind::DONE);
+        }
+    }
+    // A command that does not start where the fluid stands is refused; the fluid carries on.
+    structure.publish_kinematics(header(4, 0.2), 0, |_| ()).unwrap();
+    let command = Command::advance(4, 0.15, 0.2, scheme_phase::NONE);
+    let failed = expect_reply(&mut link, &command, reply_kind::FAILED);
+    assert_eq!(failed.code, failure_code::PROTOCOL);
+    assert!(
+        failed.message_str().contains("starts at t = 1.5e-1, but the fluid is at t = "),
+        "{}",
+        failed.message_str()
+    );
+    expect_reply(&mut link, &Command::finish(), reply_kind::DONE);
+    let out = fluid.wait_with_output().unwrap();
+    assert!(out.status.success(), "fluid-solver: {}", String::from_utf8_lossy(&out.stderr));
+    drop(structure);
+    link.remove_resources().unwrap();
+
+    // The checkpoint the launcher asked for holds the fluid at t^2.
+    let ck = Checkpoint::read(&coupled.join("checkpoints"), "step-2", "fluid").unwrap();
+    assert_eq!(ck.time, TIMES[2]);
+    for f in ["fluid.h5", "fluid.xdmf", "probes.csv", "lines/axis.csv"] {
+        assert!(coupled.join(f).is_file(), "{f} missing");
+    }
+    // The line at t = 0.05 and the final one.
+    assert_eq!(std::fs::read_dir(coupled.join("lines")).unwrap().count(), 2);
+    assert!(!coupled.join("run.json").exists(), "run.json is the launcher's");
+
+    // The stand-alone stepper driven to the same targets gives the same probes and lines.
+    let alone = dir.path().join("alone");
+    let text = std::fs::read_to_string(&case_path).unwrap();
+    let opts = RunOptions { out: alone.clone(), quiet: true, restart: None, force: false };
+    let mut run = FluidRun::open(&case, &text, &opts, Mode::Alone).unwrap();
+    for &t in &TIMES[1..] {
+        let reached = run.advance_to(t).unwrap().t;
+        assert!((reached - t).abs() <= 1e-12 * t, "{reached} for {t}");
+    }
+    let summary = run.finish().unwrap();
+    assert!(summary.steps > 4 * 4, "subcycling: {} fluid steps", summary.steps);
+    assert_same_rows(&coupled.join("probes.csv"), &alone.join("probes.csv"));
+    assert_eq!(rows(&coupled.join("probes.csv")).len() as u64, summary.steps + 1);
+    assert_same_rows(&coupled.join("lines/axis.csv"), &alone.join("lines/axis.csv"));
+
+    // And it is Sod's solution at t = 0.1.
+    let exact = ExactTube::new(
+        Eos::PerfectGas { gamma: 1.4 },
+        [1.0, 0.0, 0.0, 0.0, 1.0],
+        [0.125, 0.0, 0.0, 0.0, 0.1],
+        0.3,
+        0.1,
+    );
+    let line = rows(&coupled.join("lines/axis.csv"));
+    let err =
+        line.iter().map(|v| (v[4] - exact.at(v[0])[0]).abs()).sum::<f64>() / line.len() as f64;
+    assert!(err < 0.02, "mean density error along the line {err}");
+}
+
+#[test]
+fn a_structure_with_a_wet_surface_is_refused_at_init() {
+    let dir = tempfile::tempdir().unwrap();
+    let case_path = write_case(dir.path(), &format!("{FLUID}{WET_STRUCTURE}"));
+    let out = dir.path().join("run");
+    let start = Instant::now();
+    let r = Process::new(bin("fsi"))
+        .arg("run")
+        .arg(&case_path)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    let elapsed = start.elapsed();
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success(), "fsi succeeded: {stderr}");
+    assert!(elapsed < Duration::from_secs(10), "took {elapsed:?}: {stderr}");
+    assert!(stderr.contains(&no_embedded_boundary(4)), "{stderr}");
+    assert!(out.join("run.json").is_file());
+}
