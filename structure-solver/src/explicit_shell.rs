@@ -2,9 +2,11 @@
 //! structure-only explicit runs. Boundary conditions: fixed dofs and dofs moving at a
 //! prescribed constant velocity; loads: constant nodal forces plus whatever an integrator adds.
 //!
-//! BT4 is an explicit element: `tangent` is empty, so implicit integrators do not apply (use the
-//! MITC4 model of `assembly`); the critical step comes from the elements and from the matrix-free
-//! power iteration of [`time::critical_dt`](crate::time::critical_dt).
+//! BT4 is an explicit element: `tangent` is empty and `has_tangent` false, so static and
+//! implicit solvers refuse this model (use MITC4/DKT shells in `assembly::FeModel`, which also
+//! holds BT4 shells as `Part::Bt4` next to other parts); the critical step comes from the
+//! elements and from the matrix-free power iteration of
+//! [`time::critical_dt`](crate::time::critical_dt).
 
 use faer::sparse::Triplet;
 
@@ -113,6 +115,10 @@ impl Model for ShellModel {
     }
 
     fn tangent(&mut self, _t: f64, _out: &mut Vec<Triplet<usize, usize, f64>>) {}
+
+    fn has_tangent(&self) -> bool {
+        false
+    }
 
     fn commit(&mut self) {
         self.bt4.commit();

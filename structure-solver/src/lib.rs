@@ -3,14 +3,19 @@
 //!
 //! Modules: `mesh` (generators, gmsh reader, sets) -> `material` (elastic, J2) -> `elements`
 //! (corotational shells, beams, tets, rigid) -> `assembly` (a `Model` for the integrators) ->
-//! `time` (central difference, implicit midpoint, Newmark), `statics`, `modal`. Must not touch:
-//! the fluid, the IPC transport (coupling goes through `interface-protocol` endpoints).
+//! `time` (central difference, implicit midpoint, Newmark), `statics`, `modal`, sharing the
+//! free-dof sparse solve of `linsolve`. Must not touch: the fluid, the IPC transport (coupling
+//! goes through `interface-protocol` endpoints).
 #![deny(unsafe_op_in_unsafe_fn)]
 
 pub mod assembly;
 pub mod bench;
+pub mod couple;
+pub mod output;
+pub mod restart;
 pub mod elements;
 pub mod explicit_shell;
+pub mod linsolve;
 pub mod material;
 pub mod mesh;
 pub mod modal;

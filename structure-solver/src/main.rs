@@ -14,7 +14,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Runs a case alone.
+    /// Runs a case alone, or coupled with `--couple RUN_ID`.
     Run {
         /// The case file.
         case: std::path::PathBuf,
@@ -24,6 +24,12 @@ enum Command {
         /// Overrides `key=value` applied to the case.
         #[arg(long = "set")]
         set: Vec<String>,
+        /// Resume a run alone from the newest checkpoint in this run folder.
+        #[arg(long)]
+        restart: Option<std::path::PathBuf>,
+        /// Join the coupled run RUN_ID started by the launcher (`fsi run`).
+        #[arg(long)]
+        couple: Option<String>,
         /// No summary line.
         #[arg(long)]
         quiet: bool,
@@ -39,9 +45,21 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { case, out, set, quiet } => {
-            structure_solver::run::run(&structure_solver::run::RunOptions { case, out, set, quiet })
-                .map(|_| ())
+        Command::Run { couple: Some(_), restart: Some(_), .. } => Err(anyhow::anyhow!(
+            "--restart applies to runs alone; the launcher drives a coupled run from its start"
+        )),
+        Command::Run { case, out, set, quiet, couple: Some(run_id), .. } => {
+            structure_solver::couple::run(&case, &run_id, out, &set, quiet)
+        }
+        Command::Run { case, out, set, quiet, couple: None, restart } => {
+            structure_solver::run::run(&structure_solver::run::RunOptions {
+                case,
+                out,
+                set,
+                quiet,
+                restart,
+            })
+            .map(|_| ())
         }
         Command::Bench { quick } => structure_solver::bench::run(quick).and_then(|r| {
             println!("{}", serde_json::to_string_pretty(&r)?);

@@ -1,12 +1,13 @@
 //! Natural frequencies: the lowest eigenpairs of `K φ = ω² M φ` at the initial configuration
 //! (lumped `M`), by subspace iteration (Bathe 1996, §11.6) with a sparse LU of `K` on the
-//! free dofs.
+//! free dofs (`linsolve`).
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::Triplet;
 use faer::Mat;
 use nalgebra::DMatrix;
 
+use crate::linsolve::FreeSolver;
 use crate::model::Model;
 
 #[derive(Debug, thiserror::Error)]
@@ -15,34 +16,29 @@ pub enum ModalError {
     Singular(String),
     #[error("subspace iteration did not converge in {0} iterations")]
     NoConvergence(usize),
+    #[error("the model has explicit-only parts (BT4 shells) without a stiffness: frequencies need MITC4/DKT shells")]
+    NoTangent,
 }
 
 /// The `n` lowest circular frequencies `ω` (rad/s) of the model's free dofs.
 pub fn lowest_frequencies(model: &mut dyn Model, n: usize) -> Result<Vec<f64>, ModalError> {
-    let cons = model.constrained().to_vec();
-    let mut index = vec![usize::MAX; cons.len()];
-    let mut nf = 0;
-    for (d, &c) in cons.iter().enumerate() {
-        if !c {
-            index[d] = nf;
-            nf += 1;
-        }
+    if !model.has_tangent() {
+        return Err(ModalError::NoTangent);
     }
-    let mass: Vec<f64> =
-        (0..cons.len()).filter(|&d| !cons[d]).map(|d| model.lumped_mass()[d]).collect();
+    let mut solver = FreeSolver::new(model);
+    let nf = solver.free.len();
+    let mass = solver.free.gather(model.lumped_mass());
+    let mass: Vec<f64> = (0..nf).map(|i| mass[(i, 0)]).collect();
     let mut trip = Vec::new();
     model.tangent(0.0, &mut trip);
-    let free: Vec<Triplet<usize, usize, f64>> = trip
+    // the symmetric part ½(K + Kᵀ)
+    let sym: Vec<Triplet<usize, usize, f64>> = trip
         .iter()
-        .filter(|e| index[e.row] != usize::MAX && index[e.col] != usize::MAX)
         .flat_map(|e| {
-            let (i, j) = (index[e.row], index[e.col]);
-            [Triplet::new(i, j, 0.5 * e.val), Triplet::new(j, i, 0.5 * e.val)]
+            [Triplet::new(e.row, e.col, 0.5 * e.val), Triplet::new(e.col, e.row, 0.5 * e.val)]
         })
         .collect();
-    let k = SparseColMat::<usize, f64>::try_new_from_triplets(nf, nf, &free)
-        .map_err(|e| ModalError::Singular(format!("{e:?}")))?;
-    let lu = k.sp_lu().map_err(|e| ModalError::Singular(format!("{e:?}")))?;
+    let lu = solver.factor(&sym, 1.0, None).map_err(|e| ModalError::Singular(e.0))?;
     let p = (2 * n).max(n + 8).min(nf);
     // deterministic start vectors
     let mut x = Mat::from_fn(nf, p, |i, j| {

@@ -37,6 +37,12 @@ pub trait Model: Send {
     /// Consistent tangent (material + geometric) of internal minus external force, as triplets.
     fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>);
 
+    /// `false` when some part has no tangent (explicit-only elements): static and implicit
+    /// solvers refuse such a model.
+    fn has_tangent(&self) -> bool {
+        true
+    }
+
     /// Accepts the trial configuration and material state as converged.
     fn commit(&mut self);
 

@@ -1,11 +1,12 @@
 //! Static equilibrium of a `Model`: load-stepped Newton-Raphson with a sparse direct solve
-//! (faer LU on the free dofs) and step cutting, and displacement control (Batoz & Dhatt 1979)
+//! (`linsolve`: faer LU on the free dofs) and step cutting, and displacement control (Batoz & Dhatt 1979)
 //! for paths with limit points in load. Pseudo-time `t` is the load factor.
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::linalg::solvers::Lu;
 use faer::Mat;
 
+use crate::linsolve::{FreeDofs, FreeSolver};
 use crate::model::Model;
 
 /// Newton settings.
@@ -45,81 +46,19 @@ pub enum StaticsError {
     Singular(String),
     #[error("control dof {0} is constrained or out of range")]
     BadControl(usize),
+    #[error("the model has explicit-only parts (BT4 shells) without a tangent: a static solve needs MITC4/DKT shells")]
+    NoTangent,
 }
 
-/// The free-dof system of a model.
-struct FreeDofs {
-    index: Vec<Option<usize>>,
-    n_free: usize,
-}
-
-impl FreeDofs {
-    fn new(model: &dyn Model) -> Self {
-        let mut n_free = 0;
-        let index = model
-            .constrained()
-            .iter()
-            .map(|&c| {
-                if c {
-                    None
-                } else {
-                    n_free += 1;
-                    Some(n_free - 1)
-                }
-            })
-            .collect();
-        FreeDofs { index, n_free }
-    }
-
-    /// Factors the free-free block of the tangent at `t` (LU: the corotational tangent is not
-    /// symmetric away from equilibrium, and its symmetric part slows Newton several-fold in
-    /// large rotations).
-    fn factor(&self, model: &mut dyn Model, t: f64) -> Result<Factor, StaticsError> {
-        let mut trip = Vec::new();
-        model.tangent(t, &mut trip);
-        let free: Vec<Triplet<usize, usize, f64>> = trip
-            .iter()
-            .filter_map(|e| match (self.index[e.row], self.index[e.col]) {
-                (Some(i), Some(j)) => Some(Triplet::new(i, j, e.val)),
-                _ => None,
-            })
-            .collect();
-        let err = |e: &dyn std::fmt::Debug| StaticsError::Singular(format!("{e:?}"));
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
-            .map_err(|e| err(&e))?;
-        a.sp_lu().map(Factor::Lu).map_err(|e| err(&e))
-    }
-
-    fn gather(&self, v: &[f64]) -> Mat<f64> {
-        let mut m = Mat::zeros(self.n_free, 1);
-        for (d, i) in self.index.iter().enumerate() {
-            if let Some(i) = i {
-                m[(*i, 0)] = v[d];
-            }
-        }
-        m
-    }
-
-    fn scatter(&self, m: &Mat<f64>, out: &mut [f64]) {
-        for (d, i) in self.index.iter().enumerate() {
-            if let Some(i) = i {
-                out[d] = m[(*i, 0)];
-            }
-        }
-    }
-}
-
-/// A factored tangent.
-enum Factor {
-    Lu(faer::sparse::linalg::solvers::Lu<usize, f64>),
-}
-
-impl Factor {
-    fn solve_in_place(&self, rhs: faer::MatMut<'_, f64>) {
-        match self {
-            Factor::Lu(f) => f.solve_in_place(rhs),
-        }
-    }
+/// Factors the free-free block of the model's tangent at `t`.
+fn factor(
+    model: &mut dyn Model,
+    t: f64,
+    solver: &mut FreeSolver,
+) -> Result<Lu<usize, f64>, StaticsError> {
+    let mut trip = Vec::new();
+    model.tangent(t, &mut trip);
+    solver.factor(&trip, 1.0, None).map_err(|e| StaticsError::Singular(e.0))
 }
 
 /// Residual `f_ext - f_int` at `t` (returned: its max norm on the free dofs) and the
@@ -134,7 +73,7 @@ fn residual(model: &mut dyn Model, t: f64, fd: &FreeDofs, r: &mut [f64]) -> (f64
         en = en.max(r[d].abs());
         inn = inn.max(fi[d].abs());
         r[d] -= fi[d];
-        if fd.index[d].is_some() {
+        if fd.index(d).is_some() {
             rn = rn.max(r[d].abs());
         }
     }
@@ -151,7 +90,10 @@ pub fn load_steps(
     s: &NewtonSettings,
     mut on_step: impl FnMut(&mut dyn Model, Converged),
 ) -> Result<Vec<Converged>, StaticsError> {
-    let fd = FreeDofs::new(model);
+    if !model.has_tangent() {
+        return Err(StaticsError::NoTangent);
+    }
+    let mut solver = FreeSolver::new(model);
     let n = model.n_dof();
     let mut applied = vec![0.0; n];
     let mut t_now = 0.0;
@@ -162,7 +104,7 @@ pub fn load_steps(
         let eps = 1e-14 * target.abs().max(1.0);
         while t_now < target - eps {
             let t = (t_now + h).min(target);
-            match newton(model, t, &fd, &mut applied, s) {
+            match newton(model, t, &mut solver, &mut applied, s) {
                 Ok(c) => {
                     model.commit();
                     t_now = t;
@@ -195,7 +137,7 @@ pub fn load_steps(
 fn newton(
     model: &mut dyn Model,
     t: f64,
-    fd: &FreeDofs,
+    solver: &mut FreeSolver,
     applied: &mut [f64],
     s: &NewtonSettings,
 ) -> Result<Converged, f64> {
@@ -215,7 +157,7 @@ fn newton(
     let mut r = vec![0.0; n];
     let mut last = f64::INFINITY;
     for it in 0..=s.max_iter {
-        let (rn, scale) = residual(model, t, fd, &mut r);
+        let (rn, scale) = residual(model, t, &solver.free, &mut r);
         last = rn / scale;
         if !last.is_finite() {
             break;
@@ -226,14 +168,14 @@ fn newton(
         if it == s.max_iter {
             break;
         }
-        let lu = match fd.factor(model, t) {
+        let lu = match factor(model, t, solver) {
             Ok(lu) => lu,
             Err(_) => break,
         };
-        let mut rhs = fd.gather(&r);
+        let mut rhs = solver.free.gather(&r);
         lu.solve_in_place(rhs.as_mut());
         du.fill(0.0);
-        fd.scatter(&rhs, &mut du);
+        solver.free.scatter(&rhs, &mut du);
         if du.iter().any(|v| !v.is_finite()) {
             break;
         }
@@ -254,9 +196,13 @@ pub fn displacement_control(
     s: &NewtonSettings,
     mut on_step: impl FnMut(&mut dyn Model, Converged),
 ) -> Result<Vec<Converged>, StaticsError> {
-    let fd = FreeDofs::new(model);
+    if !model.has_tangent() {
+        return Err(StaticsError::NoTangent);
+    }
+    let mut solver = FreeSolver::new(model);
+    let fd = solver.free.clone();
     let n = model.n_dof();
-    let Some(c) = fd.index.get(control).copied().flatten() else {
+    let Some(c) = fd.index(control) else {
         return Err(StaticsError::BadControl(control));
     };
     let mut lambda = 0.0;
@@ -283,13 +229,13 @@ pub fn displacement_control(
                 break;
             }
             model.external_force(1.0, &mut fref);
-            let lu = fd.factor(model, lambda)?;
+            let lu = factor(model, lambda, &mut solver)?;
             let mut a = fd.gather(&r);
             lu.solve_in_place(a.as_mut());
             let mut b = fd.gather(&fref);
             lu.solve_in_place(b.as_mut());
             let dl = (target - uc - a[(c, 0)]) / b[(c, 0)];
-            let step = Mat::from_fn(fd.n_free, 1, |i, _| a[(i, 0)] + dl * b[(i, 0)]);
+            let step = Mat::from_fn(fd.len(), 1, |i, _| a[(i, 0)] + dl * b[(i, 0)]);
             du.fill(0.0);
             fd.scatter(&step, &mut du);
             model.apply_increment(&du);

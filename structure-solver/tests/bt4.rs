@@ -2,7 +2,8 @@
 //! in 1000 explicit steps about a skew axis, the first bending frequency of a cantilever plate
 //! in free vibration, and the plastic hinge moment at 5 and 8 thickness points.
 
-use structure_solver::elements::bt4::{Bt4, Bt4Settings, RotaryInertia};
+use structure_solver::elements::bt4::{Bt4, Bt4Settings};
+use structure_solver::elements::RotaryInertia;
 use structure_solver::explicit_shell::ShellModel;
 use structure_solver::material::{Elastic, ThicknessRule, J2};
 use structure_solver::model::Model;

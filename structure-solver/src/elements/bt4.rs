@@ -20,10 +20,11 @@
 //! nodal forces in the end geometry.
 //!
 //! Elements are evaluated in blocks of [`LANES`] with the kernel written once over
-//! [`Real`](crate::material::lanes::Real), so the compiler vectorises across elements; per-point
+//! [`Real`], so the compiler vectorises across elements; per-point
 //! state lives in flat arrays `[block][point][component][lane]`. State is double-buffered: a
 //! step reads the committed state and writes the trial state; `commit` swaps them.
 
+use super::section::{RotaryInertia, SHEAR_FACTOR};
 use crate::material::lanes::{Lanes, Real};
 use crate::material::{ThicknessRule, J2};
 
@@ -31,22 +32,10 @@ use crate::material::{ThicknessRule, J2};
 pub const LANES: usize = 8;
 type V = Lanes<LANES>;
 
-/// Transverse shear correction factor.
-const SHEAR_FACTOR: f64 = 5.0 / 6.0;
 /// Stress components per thickness point: `[σxx, σyy, σxy, σyz, σzx]`.
 pub const N_STRESS: usize = 5;
 /// Hourglass stresses per element: membrane x, y, out-of-plane w, rotations x, y.
 pub const N_HOURGLASS: usize = 5;
-
-/// How rotary inertia is lumped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RotaryInertia {
-    /// `I = m h²/12` per node: the physical value (frequency tests).
-    Physical,
-    /// `I = m (h² + A)/12` per node: scaled so rotational modes never set the explicit step
-    /// (Key & Beisinger; Hughes-Liu; otherwise `Δt ∝ h`).
-    Scaled,
-}
 
 /// Settings of a BT4 part.
 #[derive(Debug, Clone, PartialEq)]
@@ -235,10 +224,7 @@ impl Bt4 {
             let xe = c.map(|n| x[n as usize]);
             let a = frame(&xe).area;
             let m = rho * h * a / 4.0;
-            let i = match self.settings.rotary {
-                RotaryInertia::Physical => m * h * h / 12.0,
-                RotaryInertia::Scaled => m * (h * h + a) / 12.0,
-            };
+            let i = self.settings.rotary.of_node(m, h, a);
             for &n in c {
                 let n = n as usize;
                 for k in 0..3 {
@@ -268,10 +254,7 @@ impl Bt4 {
                 .sqrt()
             };
             let l = a / d(0, 2).max(d(1, 3));
-            let a_rot = match self.settings.rotary {
-                RotaryInertia::Physical => 0.0,
-                RotaryInertia::Scaled => a,
-            };
+            let a_rot = self.settings.rotary.added_area(a);
             let w2 = (12.0 * SHEAR_FACTOR * el.shear_modulus() + 4.0 * el.e * h * h / a)
                 / (el.rho * (h * h + a_rot));
             dt = dt.min(l / c).min(2.0 / w2.sqrt());

@@ -151,7 +151,9 @@ impl Reference {
             d[6 * i..6 * i + 3].copy_from_slice(ud.as_slice());
             d[6 * i + 3..6 * i + 6].copy_from_slice(th.as_slice());
             bl[i] = bi;
-            tinv[i] = tangent_inverse(&th);
+            if b.is_some() {
+                tinv[i] = tangent_inverse(&th);
+            }
         }
         if let Some(bm) = b {
             bm.fill(0.0);

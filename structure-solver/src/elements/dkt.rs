@@ -8,7 +8,8 @@
 
 use nalgebra::{DMatrix, Matrix2, Vector2};
 
-use super::section::{add_btdb, ShellSection, DRILL_PENALTY};
+use super::layered::{InPlanePoint, Layers};
+use super::section::{add_drilling_penalty, ShellSection};
 
 /// Quadratic shape functions on the triangle (corners 1-3, mid-sides 4 = 23, 5 = 31, 6 = 12)
 /// and their derivatives with respect to `(ξ, η)`.
@@ -63,20 +64,18 @@ fn kirchhoff_map(xy: &[[f64; 2]; 3]) -> DMatrix<f64> {
     t
 }
 
-/// Local 18x18 stiffness of a flat triangle with in-plane nodal coordinates `xy`.
-pub fn stiffness(xy: &[[f64; 2]; 3], sec: &ShellSection) -> DMatrix<f64> {
-    let to_d = |m: [[f64; 3]; 3]| DMatrix::from_fn(3, 3, |i, j| m[i][j]);
-    let (dm, db) = (to_d(sec.membrane()), to_d(sec.bending()));
+/// The integration points of a flat triangle with in-plane nodal coordinates `xy`: the
+/// constant membrane rows and the DKT curvature rows at the three mid-side points (exact for
+/// the quadratic elastic integrand, weight `A/3` each); the drilling penalty is the linear part.
+pub fn layers(xy: &[[f64; 2]; 3], sec: &ShellSection) -> Layers {
     let j = Matrix2::new(
         xy[1][0] - xy[0][0],
         xy[1][1] - xy[0][1],
         xy[2][0] - xy[0][0],
         xy[2][1] - xy[0][1],
     );
-    let det = j.determinant();
-    let area = 0.5 * det;
+    let area = 0.5 * j.determinant();
     let jinv = j.try_inverse().expect("degenerate triangle");
-    let mut k = DMatrix::zeros(18, 18);
 
     // constant strain membrane
     let dl = [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]];
@@ -91,11 +90,10 @@ pub fn stiffness(xy: &[[f64; 2]; 3], sec: &ShellSection) -> DMatrix<f64> {
         omega[6 * i + 1] += 0.5 * d.x;
         omega[6 * i] -= 0.5 * d.y;
     }
-    add_btdb(&mut k, &bm, &dm, area);
 
-    // DKT bending, 3-point mid-side rule (exact for the quadratic integrand)
+    // DKT bending at the mid-side points
     let t = kirchhoff_map(xy);
-    let mut kb = DMatrix::zeros(9, 9);
+    let mut points = Vec::with_capacity(3);
     for (xi, eta) in [(0.5, 0.0), (0.5, 0.5), (0.0, 0.5)] {
         let dn = quadratic(xi, eta);
         // curvature rows over the 12 nodal β values
@@ -108,27 +106,26 @@ pub fn stiffness(xy: &[[f64; 2]; 3], sec: &ShellSection) -> DMatrix<f64> {
             c[(2, 2 * a + 1)] = d.x; // βy,x
         }
         let b = c * &t;
-        add_btdb(&mut kb, &b, &db, area / 3.0);
-    }
-    for i in 0..3 {
-        for jj in 0..3 {
-            for a in 0..3 {
-                for b in 0..3 {
-                    k[(6 * i + 2 + a, 6 * jj + 2 + b)] += kb[(3 * i + a, 3 * jj + b)];
+        // [w, θx, θy] of each corner to the element's 6 dofs per node
+        let mut bb = DMatrix::zeros(3, 18);
+        for r in 0..3 {
+            for i in 0..3 {
+                for a in 0..3 {
+                    bb[(r, 6 * i + 2 + a)] = b[(r, 3 * i + a)];
                 }
             }
         }
+        points.push(InPlanePoint { weight: area / 3.0, bm: bm.clone(), bb });
     }
 
-    // drilling penalty
-    let kd = DRILL_PENALTY * sec.shear_modulus() * sec.h * area;
-    for i in 0..3 {
-        let mut r = omega.map(|v| -v);
-        r[6 * i + 5] += 1.0;
-        let rv = DMatrix::from_row_slice(1, 18, &r);
-        k.gemm_tr(kd, &rv, &rv, 1.0);
-    }
-    k
+    let mut k_linear = DMatrix::zeros(18, 18);
+    add_drilling_penalty(&mut k_linear, &omega, sec, area);
+    Layers { points, k_linear }
+}
+
+/// Local 18x18 stiffness of a flat triangle with in-plane nodal coordinates `xy`.
+pub fn stiffness(xy: &[[f64; 2]; 3], sec: &ShellSection) -> DMatrix<f64> {
+    layers(xy, sec).elastic_stiffness(sec)
 }
 
 /// Area of the triangle.

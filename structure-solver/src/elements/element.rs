@@ -1,17 +1,22 @@
-//! The element container: corotated shells and beams, total-Lagrangian tets, each with its
-//! internal force, a consistent tangent by central differences of that force (translations
+//! The element container: corotated shells (elastic, or J2 through the thickness: `layered`)
+//! and beams, total-Lagrangian tets, each with its internal force from a flat per-element
+//! material state, a consistent tangent by central differences of that force (translations
 //! perturbed additively, rotations by spatial spins, exactly as `Model::apply_increment`
 //! composes them) and a lumped mass.
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::corotation::{FrameRule, Reference};
+use super::layered::{LayeredJ2, Layers};
 use super::rotation::exp;
-use super::section::{BeamSection, ShellSection};
+use super::section::{BeamSection, ShellSection, ShellYield};
 use super::tet4::Tet4;
 use super::{beam, dkt, mitc4};
 use crate::material::j2::J2State3d;
-use crate::material::Material;
+use crate::material::{Elastic, Material, ThicknessRule, J2};
+
+/// State values of a tet's one point: plastic strain (6) and equivalent plastic strain.
+const TET_STATE: usize = 7;
 
 /// Element families, for output and sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -28,6 +33,11 @@ enum Body {
     Corotated {
         reference: Reference,
         k: DMatrix<f64>,
+    },
+    /// Corotated shell of a J2 material integrated through the thickness.
+    Layered {
+        reference: Reference,
+        shell: Box<LayeredJ2>,
     },
     Tet(Tet4),
 }
@@ -51,37 +61,64 @@ pub type LoadFn = dyn Fn(&[Vector3<f64>], &mut [f64]) + Sync;
 const FD_STEP: f64 = 1e-6;
 
 impl Element {
-    /// A 4-node MITC4 shell (`x0`: initial nodal positions, counter-clockwise about the normal).
-    pub fn quad4(nodes: [usize; 4], x0: &[Vector3<f64>; 4], sec: &ShellSection) -> Self {
+    /// A 4-node MITC4 shell (`x0`: initial nodal positions, counter-clockwise about the
+    /// normal), elastic, or J2 through the thickness with `yield_`.
+    pub fn quad4(
+        nodes: [usize; 4],
+        x0: &[Vector3<f64>; 4],
+        sec: &ShellSection,
+        yield_: Option<ShellYield>,
+    ) -> Self {
         let reference = Reference::new(FrameRule::Quad, x0);
         let xy = [0, 1, 2, 3].map(|i| [reference.a[i].x, reference.a[i].y]);
-        let k = mitc4::stiffness(&xy, sec);
+        let layers = mitc4::layers(&xy, sec);
         let area = mitc4::area(&xy);
-        Self::shell(ElementKind::Quad4, nodes.to_vec(), reference, k, area, sec)
+        Self::shell(ElementKind::Quad4, nodes.to_vec(), reference, layers, area, sec, yield_)
     }
 
-    /// A 3-node DKT shell.
-    pub fn tri3(nodes: [usize; 3], x0: &[Vector3<f64>; 3], sec: &ShellSection) -> Self {
+    /// A 3-node DKT shell, elastic or J2 through the thickness.
+    pub fn tri3(
+        nodes: [usize; 3],
+        x0: &[Vector3<f64>; 3],
+        sec: &ShellSection,
+        yield_: Option<ShellYield>,
+    ) -> Self {
         let reference = Reference::new(FrameRule::Triangle, x0);
         let xy = [0, 1, 2].map(|i| [reference.a[i].x, reference.a[i].y]);
-        let k = dkt::stiffness(&xy, sec);
+        let layers = dkt::layers(&xy, sec);
         let area = dkt::area(&xy);
-        Self::shell(ElementKind::Tri3, nodes.to_vec(), reference, k, area, sec)
+        Self::shell(ElementKind::Tri3, nodes.to_vec(), reference, layers, area, sec, yield_)
     }
 
     fn shell(
         kind: ElementKind,
         nodes: Vec<usize>,
         reference: Reference,
-        k: DMatrix<f64>,
+        layers: Layers,
         area: f64,
         sec: &ShellSection,
+        yield_: Option<ShellYield>,
     ) -> Self {
         let n = nodes.len() as f64;
         let m = sec.rho * sec.h * area / n;
         let i = sec.rho * sec.h.powi(3) / 12.0 * area / n;
         let mass = (0..nodes.len()).flat_map(|_| [m, m, m, i, i, i]).collect();
-        Element { kind, nodes, body: Body::Corotated { reference, k }, mass, measure: area }
+        let body = match yield_ {
+            None => Body::Corotated { k: layers.elastic_stiffness(sec), reference },
+            Some(y) => {
+                let material = J2 {
+                    elastic: Elastic { e: sec.e, nu: sec.nu, rho: sec.rho },
+                    sigma_y: y.sigma_y,
+                    h: y.hardening,
+                };
+                let rule = ThicknessRule::gauss(y.points);
+                Body::Layered {
+                    reference,
+                    shell: Box::new(LayeredJ2 { layers, material, rule, h: sec.h }),
+                }
+            }
+        };
+        Element { kind, nodes, body, mass, measure: area }
     }
 
     /// A 2-node beam; `up` fixes the local `y` axis (projected normal to the beam).
@@ -129,32 +166,57 @@ impl Element {
 
     /// `true` if the element has rotational freedoms.
     pub fn has_rotations(&self) -> bool {
-        matches!(self.body, Body::Corotated { .. })
+        !matches!(self.body, Body::Tet(_))
+    }
+
+    /// Length of the element's material state array (0 for elastic shells and beams).
+    pub fn n_state(&self) -> usize {
+        match &self.body {
+            Body::Corotated { .. } => 0,
+            Body::Layered { shell, .. } => shell.n_state(),
+            Body::Tet(_) => TET_STATE,
+        }
     }
 
     /// Internal force (6 per node, global) at nodal positions `x` and rotations `r` from the
-    /// committed material `state`; returns the trial state (unchanged for elastic elements).
-    pub fn force(&self, x: &[Vector3<f64>], r: &[Matrix3<f64>], state: &J2State3d, f: &mut [f64]) -> J2State3d {
+    /// committed material state `old` (`n_state` values); writes the trial state into `new`.
+    pub fn force(
+        &self,
+        x: &[Vector3<f64>],
+        r: &[Matrix3<f64>],
+        old: &[f64],
+        new: &mut [f64],
+        f: &mut [f64],
+    ) {
+        let mut d = [0.0; 24];
+        let nd = 6 * x.len();
         match &self.body {
             Body::Corotated { reference, k } => {
-                let mut d = [0.0; 24];
-                let nd = 6 * x.len();
+                // fl = K d as a sum of contiguous columns of K (column-major storage)
                 let local = |d: &[f64], fl: &mut [f64]| {
-                    for (i, o) in fl.iter_mut().enumerate() {
-                        *o = (0..nd).map(|j| k[(i, j)] * d[j]).sum();
+                    fl.fill(0.0);
+                    for (col, &dj) in k.as_slice().chunks_exact(nd).zip(d) {
+                        for (o, kij) in fl.iter_mut().zip(col) {
+                            *o += kij * dj;
+                        }
                     }
                 };
                 reference.force(x, r, &mut d[..nd], local, f);
-                *state
+            }
+            Body::Layered { reference, shell } => {
+                let local = |d: &[f64], fl: &mut [f64]| shell.force(d, old, new, fl);
+                reference.force(x, r, &mut d[..nd], local, f);
             }
             Body::Tet(t) => {
                 let xs = [x[0], x[1], x[2], x[3]];
-                let (fa, trial) = t.force(&xs, state);
+                let state = J2State3d { eps_p: std::array::from_fn(|i| old[i]), alpha: old[6] };
+                let (fa, trial) = t.force(&xs, &state);
+                new[..6].copy_from_slice(&trial.eps_p);
+                new[6] = trial.alpha;
                 f.fill(0.0);
                 for a in 0..4 {
                     f[6 * a..6 * a + 3].copy_from_slice(fa[a].as_slice());
                 }
-                trial
             }
         }
     }
@@ -162,7 +224,7 @@ impl Element {
     /// Local deformational displacements `d` of a corotated element (None for tets).
     pub fn deformation(&self, x: &[Vector3<f64>], r: &[Matrix3<f64>]) -> Option<Vec<f64>> {
         match &self.body {
-            Body::Corotated { reference, .. } => {
+            Body::Corotated { reference, .. } | Body::Layered { reference, .. } => {
                 let mut d = vec![0.0; 6 * x.len()];
                 reference.deformation(x, r, &mut d, None);
                 Some(d)
@@ -171,27 +233,24 @@ impl Element {
         }
     }
 
-    /// Tangent `∂f/∂q` by central differences of `force` (relative step `FD_STEP`; forward
-    /// differences proved too inaccurate for thin shells in large rotation); `extra` adds a configuration-dependent load term (`-f_ext`) differentiated with it.
+    /// Tangent `∂f/∂q` (with `extra`, a configuration-dependent load term `-f_ext`
+    /// differentiated with it). Elastic corotated elements: the material part `Bᵀ K B` exactly
+    /// (`B = ∂d/∂q` of `corotation`) plus the geometric part `∂(Bᵀ)/∂q f_l` (and the load term)
+    /// by forward differences at fixed local forces `f_l`. Other elements: central differences
+    /// of `force` (forward differences of the whole force proved too inaccurate for thin shells
+    /// in large rotation). Steps: `FD_STEP` relative.
     pub fn tangent(
         &self,
         x: &[Vector3<f64>],
         r: &[Matrix3<f64>],
-        state: &J2State3d,
+        state: &[f64],
         extra: Option<&LoadFn>,
     ) -> DMatrix<f64> {
         let n = x.len();
         let size = 6 * n;
-        let scale = (1..n).map(|i| (x[i] - x[0]).norm()).fold(0.0, f64::max).max(1e-300);
-        let ht = FD_STEP * scale;
-        let hr = FD_STEP;
-        let mut k = DMatrix::zeros(size, size);
-        let (mut xp, mut rp) = (x.to_vec(), r.to_vec());
-        let mut f0 = vec![0.0; size];
-        let mut fp = vec![0.0; size];
         let mut tmp = vec![0.0; size];
-        let mut eval = |xs: &[Vector3<f64>], rs: &[Matrix3<f64>], out: &mut [f64]| {
-            self.force(xs, rs, state, out);
+        let mut trial = vec![0.0; state.len()];
+        let mut minus_load = |xs: &[Vector3<f64>], out: &mut [f64]| {
             if let Some(g) = extra {
                 g(xs, &mut tmp);
                 for (o, t) in out.iter_mut().zip(&tmp) {
@@ -199,30 +258,86 @@ impl Element {
                 }
             }
         };
+        if let Body::Corotated { reference, k } = &self.body {
+            let mut d = vec![0.0; size];
+            let mut b = DMatrix::zeros(size, size);
+            reference.deformation(x, r, &mut d, Some(&mut b));
+            let fl = k * nalgebra::DVector::from_column_slice(&d);
+            let mut kt = b.transpose() * (k * &b);
+            // geometric part: forward differences of Bᵀ(q) f_l at fixed f_l
+            let mut geometric = |xs: &[Vector3<f64>], rs: &[Matrix3<f64>], out: &mut [f64]| {
+                let local = |_: &[f64], o: &mut [f64]| o.copy_from_slice(fl.as_slice());
+                reference.force(xs, rs, &mut d, local, out);
+                minus_load(xs, out);
+            };
+            let mut g0 = vec![0.0; size];
+            geometric(x, r, &mut g0);
+            let mut gp = vec![0.0; size];
+            Self::perturb(x, r, true, true, |xs, rs, col, h| {
+                geometric(xs, rs, &mut gp);
+                for i in 0..size {
+                    kt[(i, col)] += (gp[i] - g0[i]) / h;
+                }
+            });
+            return kt;
+        }
+        let mut kt = DMatrix::zeros(size, size);
+        let (mut fp, mut fm) = (vec![0.0; size], vec![0.0; size]);
+        let mut eval = |xs: &[Vector3<f64>], rs: &[Matrix3<f64>], out: &mut [f64]| {
+            self.force(xs, rs, state, &mut trial, out);
+            minus_load(xs, out);
+        };
+        let mut last = usize::MAX;
+        // each column is visited with +h, then -h
+        Self::perturb(x, r, self.has_rotations(), false, |xs, rs, col, h| {
+            if col != last {
+                eval(xs, rs, &mut fp);
+                last = col;
+            } else {
+                eval(xs, rs, &mut fm);
+                for i in 0..size {
+                    kt[(i, col)] = (fp[i] - fm[i]) / (-2.0 * h);
+                }
+            }
+        });
+        kt
+    }
+
+    /// Calls `visit(x', r', column, step)` for each perturbed configuration of the tangent:
+    /// translations moved by `±FD_STEP · size`, rotations by spatial spins `±FD_STEP`
+    /// (`forward`: `+` only; else `+` then `-` for each column); rotations only if `rotations`.
+    fn perturb(
+        x: &[Vector3<f64>],
+        r: &[Matrix3<f64>],
+        rotations: bool,
+        forward: bool,
+        mut visit: impl FnMut(&[Vector3<f64>], &[Matrix3<f64>], usize, f64),
+    ) {
+        let n = x.len();
+        let scale = (1..n).map(|i| (x[i] - x[0]).norm()).fold(0.0, f64::max).max(1e-300);
+        let (mut xp, mut rp) = (x.to_vec(), r.to_vec());
+        let signs: &[f64] = if forward { &[1.0] } else { &[1.0, -1.0] };
         for j in 0..n {
             for c in 0..6 {
-                if c >= 3 && !self.has_rotations() {
+                if c >= 3 && !rotations {
                     continue;
                 }
-                let h = if c < 3 { ht } else { hr };
-                for (sign, out) in [(1.0, &mut fp), (-1.0, &mut f0)] {
+                let h = if c < 3 { FD_STEP * scale } else { FD_STEP };
+                for sign in signs {
+                    let s = sign * h;
                     if c < 3 {
-                        xp[j][c] = x[j][c] + sign * h;
+                        xp[j][c] = x[j][c] + s;
                     } else {
                         let mut w = Vector3::zeros();
-                        w[c - 3] = sign * h;
+                        w[c - 3] = s;
                         rp[j] = exp(&w) * r[j];
                     }
-                    eval(&xp, &rp, out);
+                    visit(&xp, &rp, 6 * j + c, s);
                     xp[j] = x[j];
                     rp[j] = r[j];
                 }
-                for i in 0..size {
-                    k[(i, 6 * j + c)] = (fp[i] - f0[i]) / (2.0 * h);
-                }
             }
         }
-        k
     }
 
     /// Largest eigenvalue of `M⁻¹ K` at the initial configuration (power iteration on the
@@ -230,7 +345,7 @@ impl Element {
     pub fn max_frequency_squared(&self, x0: &[Vector3<f64>], rot_mass: &[f64]) -> f64 {
         let n = x0.len();
         let ident = vec![Matrix3::identity(); n];
-        let k = self.tangent(x0, &ident, &J2State3d::default(), None);
+        let k = self.tangent(x0, &ident, &vec![0.0; self.n_state()], None);
         let size = 6 * n;
         let minv: Vec<f64> = (0..size)
             .map(|i| {

@@ -8,7 +8,8 @@
 
 use nalgebra::{DMatrix, Matrix2, Vector2};
 
-use super::section::{add_btdb, ShellSection, DRILL_PENALTY};
+use super::layered::{InPlanePoint, Layers};
+use super::section::{add_btdb, add_drilling_penalty, ShellSection};
 
 const XI: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
 const ETA: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
@@ -52,10 +53,14 @@ fn covariant_shear(xy: &[[f64; 2]; 4], xi: f64, eta: f64, dir: usize) -> [f64; 2
     r
 }
 
-/// Local 24x24 stiffness of a flat quad with in-plane nodal coordinates `xy` (counter-clockwise).
-pub fn stiffness(xy: &[[f64; 2]; 4], sec: &ShellSection) -> DMatrix<f64> {
+/// The integration points of a flat quad with in-plane nodal coordinates `xy`
+/// (counter-clockwise): at each 2x2 Gauss point the membrane rows (with Taylor's incompatible
+/// modes condensed with the elastic membrane stiffness, a fixed linear enhancement, so the
+/// element stays exact for elastic sections) and the bending rows; the MITC4 transverse shear
+/// and the drilling penalty form the linear part.
+pub fn layers(xy: &[[f64; 2]; 4], sec: &ShellSection) -> Layers {
     let to_d = |m: [[f64; 3]; 3]| DMatrix::from_fn(3, 3, |i, j| m[i][j]);
-    let (dm, db) = (to_d(sec.membrane()), to_d(sec.bending()));
+    let dm = to_d(sec.membrane());
     let ds = DMatrix::from_diagonal_element(2, 2, sec.shear());
     let g = 1.0 / 3f64.sqrt();
     let gauss = [(-g, -g), (g, -g), (g, g), (-g, g)];
@@ -68,9 +73,11 @@ pub fn stiffness(xy: &[[f64; 2]; 4], sec: &ShellSection) -> DMatrix<f64> {
     let j0 = jacobian(xy, &dxi0, &deta0);
     let (j0inv, det0) = (j0.try_inverse().expect("degenerate quad"), j0.determinant());
 
-    let mut k = DMatrix::zeros(24, 24);
+    let mut k_linear = DMatrix::zeros(24, 24);
     let mut kaa = DMatrix::<f64>::zeros(4, 4);
     let mut kua = DMatrix::<f64>::zeros(24, 4);
+    let mut points = Vec::with_capacity(4);
+    let mut incompatible = Vec::with_capacity(4);
     for &(xi, eta) in &gauss {
         let (_, dxi, deta) = shape(xi, eta);
         let j = jacobian(xy, &dxi, &deta);
@@ -98,9 +105,7 @@ pub fn stiffness(xy: &[[f64; 2]; 4], sec: &ShellSection) -> DMatrix<f64> {
             bs[(0, c)] = cart.x;
             bs[(1, c)] = cart.y;
         }
-        add_btdb(&mut k, &bm, &dm, det);
-        add_btdb(&mut k, &bb, &db, det);
-        add_btdb(&mut k, &bs, &ds, det);
+        add_btdb(&mut k_linear, &bs, &ds, det);
         // incompatible modes P1 = 1 - ξ², P2 = 1 - η² for u and v, derivatives through J0
         // scaled by det J0 / det J so that ∫ G dA = 0 (patch test).
         let p1 = j0inv * Vector2::new(-2.0 * xi, 0.0) * (det0 / det);
@@ -114,26 +119,32 @@ pub fn stiffness(xy: &[[f64; 2]; 4], sec: &ShellSection) -> DMatrix<f64> {
         }
         add_btdb(&mut kaa, &ginc, &dm, det);
         kua.gemm_tr(det, &bm, &(&dm * &ginc), 1.0);
+        points.push(InPlanePoint { weight: det, bm, bb });
+        incompatible.push(ginc);
     }
+    // Condensed modes α = -Kαα⁻¹ Kuαᵀ d: membrane rows B_m + G A reproduce
+    // K_uu - Kuα Kαα⁻¹ Kuαᵀ exactly.
     let kaa_inv = kaa.try_inverse().expect("incompatible-mode block is positive definite");
-    k -= &kua * kaa_inv * kua.transpose();
+    let a = -(kaa_inv * kua.transpose());
+    for (p, ginc) in points.iter_mut().zip(&incompatible) {
+        p.bm += ginc * &a;
+    }
 
     // drilling penalty: θz_i - ω_c, ω_c = ½(v,x - u,y) at the centroid
     let area = 4.0 * det0;
-    let kd = DRILL_PENALTY * sec.shear_modulus() * sec.h * area;
     let mut omega = [0.0; 24];
     for i in 0..4 {
         let d = j0inv * Vector2::new(dxi0[i], deta0[i]);
         omega[6 * i + 1] += 0.5 * d.x;
         omega[6 * i] -= 0.5 * d.y;
     }
-    for i in 0..4 {
-        let mut r = omega.map(|v| -v);
-        r[6 * i + 5] += 1.0;
-        let rv = DMatrix::from_row_slice(1, 24, &r);
-        k.gemm_tr(kd, &rv, &rv, 1.0);
-    }
-    k
+    add_drilling_penalty(&mut k_linear, &omega, sec, area);
+    Layers { points, k_linear }
+}
+
+/// Local 24x24 stiffness of a flat quad with in-plane nodal coordinates `xy` (counter-clockwise).
+pub fn stiffness(xy: &[[f64; 2]; 4], sec: &ShellSection) -> DMatrix<f64> {
+    layers(xy, sec).elastic_stiffness(sec)
 }
 
 /// Area of the flat quad.

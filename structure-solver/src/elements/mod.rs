@@ -1,16 +1,19 @@
 //! Finite elements (DESIGN §6): one corotated frame shared by the shells and beams
-//! (`corotation`), the local small-strain elements it carries (`mitc4`, `dkt`, `beam`), the
-//! total-Lagrangian tetrahedron `tet4`, and the element container the assembly loops over.
+//! (`corotation`), the local small-strain elements it carries (`mitc4`, `dkt`, `beam`; J2
+//! shells integrated through the thickness in `layered`), the total-Lagrangian tetrahedron
+//! `tet4`, the explicit one-point shell `bt4`, and the element container the assembly loops
+//! over.
 
 pub mod beam;
 pub mod bt4;
 pub mod corotation;
 pub mod dkt;
 pub mod element;
+pub mod layered;
 pub mod mitc4;
 pub mod rotation;
 pub mod section;
 pub mod tet4;
 
 pub use element::{Element, ElementKind};
-pub use section::{BeamSection, ShellSection};
+pub use section::{BeamSection, RotaryInertia, ShellSection, ShellYield};

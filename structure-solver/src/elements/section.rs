@@ -9,12 +9,51 @@ pub struct ShellSection {
     pub h: f64,
 }
 
+/// J2 yield of a shell section (linear isotropic hardening, `hardening` the plastic modulus
+/// `H` of `material::j2`), integrated at `points` Gauss-Legendre points through the thickness
+/// (>= 8 for the fully plastic moment; 5 reach `Σ wᵢ|ζᵢ|` = 0.945 of it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShellYield {
+    pub sigma_y: f64,
+    pub hardening: f64,
+    pub points: usize,
+}
+
 /// Drilling penalty: nodal rotations about the element normal are tied to the in-plane
 /// rotation `ω = ½(∂v/∂x - ∂u/∂y)` of the membrane field at the centroid with stiffness
 /// `DRILL_PENALTY · G h A` per node. Small enough not to stiffen the shell measurably
 /// (the Sze hemisphere moves by about 0.1% between 1e-5 and 1e-3), large enough to make the
 /// drilling freedoms of flat and nearly flat meshes non-singular.
 pub const DRILL_PENALTY: f64 = 1e-4;
+
+/// Rotary inertia of shell nodes: physical, `I = m h²/12` (frequency tests and implicit runs),
+/// or scaled for explicit steps, `I = m (h² + A)/12` (Key & Beisinger 1971; Belytschko, Lin &
+/// Tsay 1984), so that the Mindlin rotational modes do not set `Δt ∝ h`; `m` is the node's
+/// share of the element mass, `A` the element area.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RotaryInertia {
+    Physical,
+    Scaled,
+}
+
+impl RotaryInertia {
+    /// Rotary inertia of a node of translational mass `m` of a shell of thickness `h` and
+    /// element area `area`.
+    pub fn of_node(self, m: f64, h: f64, area: f64) -> f64 {
+        match self {
+            RotaryInertia::Physical => m * h * h / 12.0,
+            RotaryInertia::Scaled => m * (h * h + area) / 12.0,
+        }
+    }
+
+    /// The area `A` added to `h²` (0 for the physical inertia).
+    pub fn added_area(self, area: f64) -> f64 {
+        match self {
+            RotaryInertia::Physical => 0.0,
+            RotaryInertia::Scaled => area,
+        }
+    }
+}
 
 /// Transverse shear correction factor of Reissner-Mindlin shells.
 pub const SHEAR_FACTOR: f64 = 5.0 / 6.0;
@@ -81,4 +120,23 @@ pub(crate) fn add_btdb(
 ) {
     let db = d * b;
     k.gemm_tr(w, b, &db, 1.0);
+}
+
+/// Adds the drilling penalty `½ DRILL_PENALTY G h A Σᵢ (θzᵢ - ω)²` to the local stiffness `k`
+/// (6 dofs per node); `omega` is the row of `ω = ½(∂v/∂x - ∂u/∂y)` at the centroid over the
+/// element dofs.
+pub(crate) fn add_drilling_penalty(
+    k: &mut nalgebra::DMatrix<f64>,
+    omega: &[f64],
+    sec: &ShellSection,
+    area: f64,
+) {
+    let kd = DRILL_PENALTY * sec.shear_modulus() * sec.h * area;
+    let n = omega.len();
+    for i in 0..n / 6 {
+        let mut r: Vec<f64> = omega.iter().map(|v| -v).collect();
+        r[6 * i + 5] += 1.0;
+        let rv = nalgebra::DMatrix::from_row_slice(1, n, &r);
+        k.gemm_tr(kd, &rv, &rv, 1.0);
+    }
 }

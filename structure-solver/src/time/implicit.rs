@@ -1,4 +1,4 @@
-//! Implicit steps with Newton and a sparse direct solve (faer LU on the free dofs):
+//! Implicit steps with Newton and a sparse direct solve (`linsolve`: faer LU on the free dofs):
 //!
 //! - **Newmark, average acceleration** (β = 1/4, γ = 1/2; Newmark 1959): unknown `Δu`,
 //!   `a^{n+1} = 4/Δt² (Δu - Δt v^n) - a^n`, `v^{n+1} = v^n + Δt/2 (a^n + a^{n+1})`, residual
@@ -11,11 +11,10 @@
 //! Both have the discrete frequency `tan(ΩΔt/2) = ωΔt/2` on a linear oscillator.
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::Mat;
+use faer::sparse::Triplet;
 
 use super::{out_of_balance, prescribed_increment, Dynamics};
+use crate::linsolve::FreeSolver;
 use crate::model::Model;
 
 /// Which implicit rule.
@@ -54,6 +53,8 @@ pub enum ImplicitError {
     NoConvergence { t: f64, iterations: usize, residual: f64, reference: f64 },
     #[error("the effective matrix is singular: {0}")]
     Singular(String),
+    #[error("the model has explicit-only parts (BT4 shells) without a tangent: implicit steps need MITC4/DKT shells; use central differences")]
+    NoTangent,
 }
 
 /// An implicit integrator with its free-dof numbering and work arrays.
@@ -62,17 +63,13 @@ pub struct Implicit {
     pub scheme: ImplicitScheme,
     pub state: Dynamics,
     pub params: NewtonParams,
-    free: Vec<Option<usize>>,
-    n_free: usize,
+    solver: FreeSolver,
     fi: Vec<f64>,
     r: Vec<f64>,
     du: Vec<f64>,
     delta: Vec<f64>,
     scratch: Vec<f64>,
     triplets: Vec<Triplet<usize, usize, f64>>,
-    /// Symbolic LU and the column pointers and row indices it was made for: reused while the
-    /// sparsity pattern of the effective matrix does not change.
-    symbolic: Option<(SymbolicLu<usize>, Vec<usize>, Vec<usize>)>,
 }
 
 impl Implicit {
@@ -98,30 +95,17 @@ impl Implicit {
     /// Resumes from a checkpointed state.
     pub fn resume(model: &dyn Model, scheme: ImplicitScheme, state: Dynamics) -> Self {
         let n = model.n_dof();
-        let mut n_free = 0;
-        let free = model
-            .constrained()
-            .iter()
-            .map(|&c| {
-                (!c).then(|| {
-                    n_free += 1;
-                    n_free - 1
-                })
-            })
-            .collect();
         Implicit {
             scheme,
             state,
             params: NewtonParams::default(),
-            free,
-            n_free,
+            solver: FreeSolver::new(model),
             fi: vec![0.0; n],
             r: vec![0.0; n],
             du: vec![0.0; n],
             delta: vec![0.0; n],
             scratch: vec![0.0; n],
             triplets: Vec::new(),
-            symbolic: None,
         }
     }
 
@@ -151,6 +135,9 @@ impl Implicit {
         dt: f64,
         extra: Option<&[f64]>,
     ) -> Result<StepInfo, ImplicitError> {
+        if !model.has_tangent() {
+            return Err(ImplicitError::NoTangent);
+        }
         let n = model.n_dof();
         let t0 = self.state.t;
         let (cm, ck, stage) = self.coefficients(dt);
@@ -196,47 +183,13 @@ impl Implicit {
             // Jacobian cm M + ck K on the free dofs; solve J δ = r (r = -residual).
             self.triplets.clear();
             model.tangent(t_load, &mut self.triplets);
-            let mut free: Vec<Triplet<usize, usize, f64>> = self
-                .triplets
-                .iter()
-                .filter_map(|e| match (self.free[e.row], self.free[e.col]) {
-                    (Some(i), Some(j)) => Some(Triplet::new(i, j, ck * e.val)),
-                    _ => None,
-                })
-                .collect();
-            for (i, f) in self.free.iter().enumerate() {
-                if let Some(k) = f {
-                    free.push(Triplet::new(*k, *k, cm * mass[i]));
-                }
-            }
-            let jac =
-                SparseColMat::<usize, f64>::try_new_from_triplets(self.n_free, self.n_free, &free)
-                    .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
-            let same = self.symbolic.as_ref().is_some_and(|(_, cp, ri)| {
-                cp.as_slice() == jac.symbolic().col_ptr()
-                    && ri.as_slice() == jac.symbolic().row_idx()
-            });
-            if !same {
-                let sym = SymbolicLu::try_new(jac.symbolic())
-                    .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
-                self.symbolic = Some((
-                    sym,
-                    jac.symbolic().col_ptr().to_vec(),
-                    jac.symbolic().row_idx().to_vec(),
-                ));
-            }
-            let sym = self.symbolic.as_ref().map(|s| s.0.clone()).expect("set above");
-            let lu = Lu::try_new_with_symbolic(sym, jac.as_ref())
-                .map_err(|e| ImplicitError::Singular(format!("{e:?}")))?;
-            let mut rhs = Mat::<f64>::zeros(self.n_free, 1);
-            for (i, f) in self.free.iter().enumerate() {
-                if let Some(k) = f {
-                    rhs[(*k, 0)] = self.r[i];
-                }
-            }
-            let sol = lu.solve(&rhs);
-            for (i, f) in self.free.iter().enumerate() {
-                let d = f.map_or(0.0, |k| sol[(k, 0)]);
+            let lu = self
+                .solver
+                .factor(&self.triplets, ck, Some((cm, &mass)))
+                .map_err(|e| ImplicitError::Singular(e.0))?;
+            let sol = lu.solve(&self.solver.free.gather(&self.r));
+            for (i, &c) in constrained.iter().enumerate() {
+                let d = if c { 0.0 } else { sol[(self.solver.free.index(i).expect("free"), 0)] };
                 self.du[i] += d;
                 self.delta[i] = stage * d;
             }
