@@ -11,8 +11,6 @@
 pub mod assembly;
 pub mod bench;
 pub mod couple;
-pub mod output;
-pub mod restart;
 pub mod elements;
 pub mod explicit_shell;
 pub mod linsolve;
@@ -20,6 +18,8 @@ pub mod material;
 pub mod mesh;
 pub mod modal;
 pub mod model;
+pub mod output;
+pub mod restart;
 pub mod run;
 pub mod statics;
 pub mod time;

@@ -1,6 +1,7 @@
 //! `structure-solver`: runs a case alone or as a coupled participant, or benches the kernels.
 
 use clap::{Parser, Subcommand};
+use interface_protocol::cli::RunArgs;
 
 #[derive(Parser)]
 #[command(
@@ -16,23 +17,11 @@ struct Cli {
 enum Command {
     /// Runs a case alone, or coupled with `--couple RUN_ID`.
     Run {
-        /// The case file.
-        case: std::path::PathBuf,
-        /// Output folder; default `runs/<case>-<timestamp>`.
-        #[arg(long)]
-        out: Option<std::path::PathBuf>,
-        /// Overrides `key=value` applied to the case.
-        #[arg(long = "set")]
-        set: Vec<String>,
+        #[command(flatten)]
+        args: RunArgs,
         /// Resume a run alone from the newest checkpoint in this run folder.
         #[arg(long)]
         restart: Option<std::path::PathBuf>,
-        /// Join the coupled run RUN_ID started by the launcher (`fsi run`).
-        #[arg(long)]
-        couple: Option<String>,
-        /// No summary line.
-        #[arg(long)]
-        quiet: bool,
     },
     /// Prints the explicit BT4 and implicit Newmark speeds as JSON.
     Bench {
@@ -45,13 +34,15 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { couple: Some(_), restart: Some(_), .. } => Err(anyhow::anyhow!(
-            "--restart applies to runs alone; the launcher drives a coupled run from its start"
-        )),
-        Command::Run { case, out, set, quiet, couple: Some(run_id), .. } => {
+        Command::Run { args: RunArgs { couple: Some(_), .. }, restart: Some(_) } => {
+            Err(anyhow::anyhow!(
+                "--restart applies to runs alone; the launcher drives a coupled run from its start"
+            ))
+        }
+        Command::Run { args: RunArgs { case, out, set, quiet, couple: Some(run_id) }, .. } => {
             structure_solver::couple::run(&case, &run_id, out, &set, quiet)
         }
-        Command::Run { case, out, set, quiet, couple: None, restart } => {
+        Command::Run { args: RunArgs { case, out, set, quiet, couple: None }, restart } => {
             structure_solver::run::run(&structure_solver::run::RunOptions {
                 case,
                 out,

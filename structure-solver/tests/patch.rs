@@ -187,7 +187,10 @@ fn tet_patch() -> Mesh {
 #[test]
 fn tet_constant_strain_patch() {
     let mesh = tet_patch();
-    let mut model = FeModel::new(&mesh, |_| Part::Solid(Material::Elastic(Elastic { e: 1e6, nu: 0.3, rho: 1.0 }))).unwrap();
+    let mut model = FeModel::new(&mesh, |_| {
+        Part::Solid(Material::Elastic(Elastic { e: 1e6, nu: 0.3, rho: 1.0 }))
+    })
+    .unwrap();
     let s = 1e-6;
     let grad = [[1.0, 0.3, -0.2], [0.1, -0.5, 0.4], [0.2, 0.6, 0.8]];
     let field = |p: [f64; 3]| [0, 1, 2].map(|i| s * (0..3).map(|j| grad[i][j] * p[j]).sum::<f64>());

@@ -43,14 +43,19 @@ impl Tet4 {
     /// Second Piola-Kirchhoff stress at `F` from the committed `state`, and the trial state.
     pub fn pk2(&self, f: &Matrix3<f64>, state: &J2State3d) -> (Matrix3<f64>, J2State3d) {
         let e = 0.5 * (f.transpose() * f - Matrix3::identity());
-        let eps = [e[(0, 0)], e[(1, 1)], e[(2, 2)], 2.0 * e[(0, 1)], 2.0 * e[(1, 2)], 2.0 * e[(2, 0)]];
+        let eps =
+            [e[(0, 0)], e[(1, 1)], e[(2, 2)], 2.0 * e[(0, 1)], 2.0 * e[(1, 2)], 2.0 * e[(2, 0)]];
         let (s, trial, _) = self.material.update_3d(&eps, state);
         let m = Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2]);
         (m, trial)
     }
 
     /// Nodal internal forces `f_a = V0 F S ∇N_a` and the trial material state.
-    pub fn force(&self, x: &[Vector3<f64>; 4], state: &J2State3d) -> ([Vector3<f64>; 4], J2State3d) {
+    pub fn force(
+        &self,
+        x: &[Vector3<f64>; 4],
+        state: &J2State3d,
+    ) -> ([Vector3<f64>; 4], J2State3d) {
         let f = self.deformation_gradient(x);
         let (s, trial) = self.pk2(&f, state);
         let p = f * s;
