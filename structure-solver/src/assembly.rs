@@ -7,6 +7,13 @@
 //! follower pressure on shells and an external nodal array filled by the coupling. Each load
 //! scales with a `Curve` of time; static solves use `t` as the load factor.
 //!
+//! Rigid bodies and links (`rigid`): slave nodes follow a master node; the model then returns
+//! reduced forces `Tᵀ f` and tangent `Tᵀ K T` (plus the geometric term of the rotating
+//! offsets), marks the slave dofs constrained, and moves slaves with their master in
+//! `apply_increment`, so the static and implicit solvers need nothing more; the explicit
+//! integrator uses the `Model` hooks for the master's mass block and free rigid-body drift.
+//! A master at a point or at the mass centre is a node appended after the mesh nodes.
+//!
 //! Parts: elastic shells, J2 shells integrated through the thickness (MITC4, DKT), beams,
 //! tets, and the explicit-only one-point BT4 shells, which have no tangent (static and
 //! implicit solvers return an error for a model holding them).
@@ -22,6 +29,7 @@ use crate::elements::{BeamSection, Element, ElementKind, ShellSection, ShellYiel
 use crate::material::{Elastic, Material, ThicknessRule, J2};
 use crate::mesh::{CellKind, Mesh};
 use crate::model::Model;
+use crate::rigid::{ExtraMass, RigidBody, RigidError, RigidReference};
 
 /// A scalar function of time multiplying a load or a prescribed value.
 #[derive(Debug, Clone, PartialEq)]
@@ -111,8 +119,22 @@ pub struct FeModel {
     /// The explicit-only BT4 shells, if any.
     bt4: Option<Bt4Part>,
     rotary: RotaryInertia,
+    /// Lumped mass of the model's free dofs (rigid bodies reduced to their masters).
     mass: Vec<f64>,
+    /// Lumped mass of every node as the elements give it (before the rigid reduction).
+    node_mass: Vec<f64>,
     constrained: Vec<bool>,
+    /// Dofs fixed or prescribed by the user (the others of `constrained` have no stiffness
+    /// or are rigid slaves).
+    user_fixed: Vec<bool>,
+    rigid: Vec<RigidBody>,
+    /// Rigid body of each node (master or slave), and whether it is a slave.
+    body_of: Vec<Option<usize>>,
+    slave: Vec<bool>,
+    /// Internal force before the rigid reduction at the current configuration, if
+    /// `fint_valid` (the tangent's geometric term of rigid offsets reads it).
+    fint_full: Vec<f64>,
+    fint_valid: bool,
     prescribed: Vec<(usize, f64, Curve)>,
     point_loads: Vec<(usize, f64, Curve)>,
     pressures: Vec<(Vec<usize>, f64, Curve)>,
@@ -248,7 +270,14 @@ impl FeModel {
             bt4,
             rotary: RotaryInertia::Physical,
             mass: vec![],
+            node_mass: vec![],
             constrained,
+            user_fixed: vec![false; 6 * nn],
+            rigid: vec![],
+            body_of: vec![None; nn],
+            slave: vec![false; nn],
+            fint_full: vec![],
+            fint_valid: false,
             prescribed: vec![],
             point_loads: vec![],
             pressures: vec![],
@@ -310,7 +339,227 @@ impl FeModel {
             b.shells.lumped_mass(&x0, &mut mass);
             self.dt_crit = self.dt_crit.min(b.shells.stable_dt(&x0));
         }
-        self.mass = mass;
+        self.node_mass = mass;
+        self.reduce_mass();
+    }
+
+    /// The lumped mass of the free dofs: rigid slaves carry nothing, masters the diagonal of
+    /// their body's mass block in the current orientation (the full block acts through the
+    /// `Model` mass hooks).
+    fn reduce_mass(&mut self) {
+        self.mass.clone_from(&self.node_mass);
+        for b in &mut self.rigid {
+            b.set_mass(&self.node_mass);
+            let m6 = b.mass6(&self.trial.r[b.master]);
+            for c in 0..6 {
+                self.mass[6 * b.master + c] = m6[(c, c)];
+            }
+            for &s in &b.slaves {
+                self.mass[6 * s..6 * s + 6].fill(0.0);
+            }
+        }
+    }
+
+    /// Makes `nodes` a rigid body on the master `reference` with the mass and inertia of its
+    /// nodes plus `extra`; returns the master node. A two-node set is a rigid link. Each node
+    /// belongs to at most one body; slaves may carry no fixed or prescribed dof (define those
+    /// before the body: later ones on slaves have no effect), the master may. `Point` and
+    /// `MassCentre` append a node (index `n_nodes()` before the call) with six free dofs and no
+    /// element; `Node` may name a node outside the set, which then joins the body. Loads on
+    /// slaves (point loads, pressure, gravity, the coupling's nodal array) reach the master as
+    /// a force and a moment about it.
+    pub fn rigid_body(
+        &mut self,
+        nodes: &[usize],
+        reference: RigidReference,
+        extra: ExtraMass,
+    ) -> Result<usize, RigidError> {
+        let nn = self.x0.len();
+        let mut set = nodes.to_vec();
+        set.sort_unstable();
+        set.dedup();
+        if set.is_empty() {
+            return Err(RigidError::Empty);
+        }
+        let mut check = set.clone();
+        if let RigidReference::Node(m) = reference {
+            check.push(m);
+        }
+        for &n in &check {
+            if n >= nn {
+                return Err(RigidError::NodeRange { node: n, n: nn });
+            }
+            if let Some(body) = self.body_of[n] {
+                return Err(RigidError::TwoBodies { node: n, body });
+            }
+        }
+        let (master, point) = match reference {
+            RigidReference::Node(m) => (m, None),
+            RigidReference::Point(p) => (nn, Some(Vector3::from(p))),
+            RigidReference::MassCentre => {
+                let c = RigidBody::centre_of(&set, &self.trial.x, &extra, &self.node_mass);
+                (nn, Some(c.ok_or(RigidError::NoMass)?))
+            }
+        };
+        let slaves: Vec<usize> = set.into_iter().filter(|&n| n != master).collect();
+        for &s in &slaves {
+            if let Some(dof) = (0..6).find(|&c| self.user_fixed[6 * s + c]) {
+                return Err(RigidError::ConstrainedSlave { node: s, dof });
+            }
+        }
+        let (mut x, mut r, mut node_mass) =
+            (self.trial.x.clone(), self.trial.r.clone(), self.node_mass.clone());
+        if let Some(p) = point {
+            x.push(p);
+            r.push(Matrix3::identity());
+            node_mass.extend([0.0; 6]);
+        }
+        let body = RigidBody::new(master, slaves, &x, &r, &extra, &node_mass)?;
+        if let Some(p) = point {
+            self.add_node(p);
+        }
+        let id = self.rigid.len();
+        self.body_of[master] = Some(id);
+        for c in 0..6 {
+            // the body gives the master inertia and, through the slaves, stiffness
+            self.constrained[6 * master + c] = self.user_fixed[6 * master + c];
+        }
+        for &s in &body.slaves {
+            self.body_of[s] = Some(id);
+            self.slave[s] = true;
+            self.constrained[6 * s..6 * s + 6].fill(true);
+        }
+        self.rigid.push(body);
+        self.reduce_mass();
+        self.fint_valid = false;
+        Ok(master)
+    }
+
+    /// The rigid bodies, in the order they were made.
+    pub fn rigid_bodies(&self) -> &[RigidBody] {
+        &self.rigid
+    }
+
+    /// Appends a node at `p` (no element, six free dofs, no mass of its own).
+    fn add_node(&mut self, p: Vector3<f64>) {
+        self.x0.push(p);
+        for s in [&mut self.trial, &mut self.committed] {
+            s.x.push(p);
+            s.r.push(Matrix3::identity());
+            s.spin_sum.push(Vector3::zeros());
+        }
+        self.mass.extend([0.0; 6]);
+        self.node_mass.extend([0.0; 6]);
+        self.constrained.extend([false; 6]);
+        self.user_fixed.extend([false; 6]);
+        self.external.extend([0.0; 6]);
+        self.body_of.push(None);
+        self.slave.push(false);
+        if let Some(b) = &mut self.bt4 {
+            b.x.push([p.x, p.y, p.z]);
+            b.du.extend([0.0; 6]);
+        }
+    }
+
+    /// Moves every slave with its master (positions, rotations and accumulated spins).
+    fn place_slaves(&mut self, du: &[f64]) {
+        let s = &mut self.trial;
+        for b in &self.rigid {
+            let (xm, rm) = (s.x[b.master], s.r[b.master]);
+            let w = Vector3::new(du[6 * b.master + 3], du[6 * b.master + 4], du[6 * b.master + 5]);
+            for (k, &n) in b.slaves.iter().enumerate() {
+                (s.x[n], s.r[n]) = b.slave(k, &xm, &rm);
+                s.spin_sum[n] += w;
+            }
+        }
+    }
+
+    /// `f ← Tᵀ f`: slave forces and moments move to their master (moment of the force about
+    /// the master added); slave entries become zero.
+    fn reduce_forces(&self, f: &mut [f64]) {
+        let x = &self.trial.x;
+        for b in &self.rigid {
+            let m = b.master;
+            for &s in &b.slaves {
+                let force = Vector3::new(f[6 * s], f[6 * s + 1], f[6 * s + 2]);
+                let moment = (x[s] - x[m]).cross(&force);
+                for c in 0..3 {
+                    f[6 * m + c] += f[6 * s + c];
+                    f[6 * m + 3 + c] += f[6 * s + 3 + c] + moment[c];
+                }
+                f[6 * s..6 * s + 6].fill(0.0);
+            }
+        }
+    }
+
+    /// `K ← Tᵀ K T` on triplets, plus the geometric term of the rotating offsets
+    /// `Σ_s [g_s]× [r_s]×` on the master's rotations (`g_s` the slave's internal minus external
+    /// force, `r_s = x_s - x_m`).
+    fn reduce_tangent(&mut self, t: f64, k: &mut Vec<Triplet<usize, usize, f64>>) {
+        use crate::elements::rotation::spin;
+        if !self.fint_valid {
+            let mut f = vec![0.0; self.n_dof()];
+            self.internal_force(&mut f);
+        }
+        let mut fext = vec![0.0; self.n_dof()];
+        self.external_unreduced(t, &mut fext);
+        let x = &self.trial.x;
+        // per node: (master, r_s) of slaves
+        let mut link: Vec<Option<(usize, Vector3<f64>)>> = vec![None; x.len()];
+        for b in &self.rigid {
+            for &s in &b.slaves {
+                link[s] = Some((b.master, x[s] - x[b.master]));
+            }
+        }
+        // column d of T: (reduced dof, coefficient) pairs
+        let expand = |d: usize| -> ([(usize, f64); 4], usize) {
+            let (n, c) = (d / 6, d % 6);
+            match link[n] {
+                None => ([(d, 1.0); 4], 1),
+                Some((m, _)) if c >= 3 => ([(6 * m + c, 1.0); 4], 1),
+                Some((m, r)) => {
+                    // δu_s = δu_m - [r]× δθ_m
+                    let s = -spin(&r);
+                    let mut out = [(6 * m + c, 1.0); 4];
+                    let mut len = 1;
+                    for j in 0..3 {
+                        if s[(c, j)] != 0.0 {
+                            out[len] = (6 * m + 3 + j, s[(c, j)]);
+                            len += 1;
+                        }
+                    }
+                    (out, len)
+                }
+            }
+        };
+        let mut out = Vec::with_capacity(k.len());
+        for e in k.iter() {
+            if link[e.row / 6].is_none() && link[e.col / 6].is_none() {
+                out.push(*e);
+                continue;
+            }
+            let (rows, nr) = expand(e.row);
+            let (cols, nc) = expand(e.col);
+            for &(i, a) in &rows[..nr] {
+                for &(j, b) in &cols[..nc] {
+                    out.push(Triplet::new(i, j, a * e.val * b));
+                }
+            }
+        }
+        for (s, l) in link.iter().enumerate() {
+            if let Some((m, r)) = l {
+                let g = Vector3::from_fn(|c, _| self.fint_full[6 * s + c] - fext[6 * s + c]);
+                let gr = spin(&g) * spin(r);
+                for i in 0..3 {
+                    for j in 0..3 {
+                        if gr[(i, j)] != 0.0 {
+                            out.push(Triplet::new(6 * m + 3 + i, 6 * m + 3 + j, gr[(i, j)]));
+                        }
+                    }
+                }
+            }
+        }
+        *k = out;
     }
 
     /// Holds dofs `mask` (`[ux, uy, uz, θx, θy, θz]`) of `nodes` at zero.
@@ -319,6 +568,7 @@ impl FeModel {
             for c in 0..6 {
                 if mask[c] {
                     self.constrained[6 * n + c] = true;
+                    self.user_fixed[6 * n + c] = true;
                 }
             }
         }
@@ -338,6 +588,7 @@ impl FeModel {
     pub fn prescribe(&mut self, nodes: &[usize], c: usize, value: f64, curve: Curve) {
         for &n in nodes {
             self.constrained[6 * n + c] = true;
+            self.user_fixed[6 * n + c] = true;
             self.prescribed.push((6 * n + c, value, curve.clone()));
         }
     }
@@ -383,6 +634,7 @@ impl FeModel {
     pub fn set_configuration(&mut self, x: &[Vector3<f64>], r: &[Matrix3<f64>]) {
         self.trial.x.copy_from_slice(x);
         self.trial.r.copy_from_slice(r);
+        self.fint_valid = false;
     }
 
     /// Total pressure on each mesh cell at time `t`.
@@ -438,8 +690,12 @@ impl Model for FeModel {
     }
 
     fn apply_increment(&mut self, du: &[f64]) {
+        self.fint_valid = false;
         let s = &mut self.trial;
         for n in 0..s.x.len() {
+            if self.slave[n] {
+                continue;
+            }
             let d = &du[6 * n..6 * n + 6];
             s.x[n] += Vector3::new(d[0], d[1], d[2]);
             let w = Vector3::new(d[3], d[4], d[5]);
@@ -447,6 +703,9 @@ impl Model for FeModel {
                 s.r[n] = crate::elements::rotation::exp(&w) * s.r[n];
                 s.spin_sum[n] += w;
             }
+        }
+        if !self.rigid.is_empty() {
+            self.place_slaves(du);
         }
     }
 
@@ -495,9 +754,160 @@ impl Model for FeModel {
             b.shells.internal_force(&b.x, &b.du, f);
             b.evaluated = true;
         }
+        if !self.rigid.is_empty() {
+            self.fint_full.clear();
+            self.fint_full.extend_from_slice(f);
+            self.fint_valid = true;
+            self.reduce_forces(f);
+        }
     }
 
     fn external_force(&mut self, t: f64, f: &mut [f64]) {
+        self.external_unreduced(t, f);
+        if self.rigid.is_empty() {
+            return;
+        }
+        if let Some((g, c)) = &self.gravity {
+            // the weight of extra masses, at their centres
+            let s = c.at(t);
+            for b in &self.rigid {
+                let (mass, arm) = b.extra_weight(&self.trial.r[b.master]);
+                if mass > 0.0 {
+                    let w = Vector3::from(*g) * (mass * s);
+                    let moment = arm.cross(&w);
+                    for k in 0..3 {
+                        f[6 * b.master + k] += w[k];
+                        f[6 * b.master + 3 + k] += moment[k];
+                    }
+                }
+            }
+        }
+        self.reduce_forces(f);
+    }
+
+    /// Tangent of internal minus external force, reduced by the rigid bodies.
+    fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
+        self.element_tangent(t, out);
+        if !self.rigid.is_empty() {
+            self.reduce_tangent(t, out);
+        }
+    }
+
+    fn apply_inverse_mass(&self, f: &[f64], a: &mut [f64]) {
+        let (m, c) = (&self.mass, &self.constrained);
+        for (i, a) in a.iter_mut().enumerate() {
+            *a = if c[i] || m[i] <= 0.0 { 0.0 } else { f[i] / m[i] };
+        }
+        for b in &self.rigid {
+            let d = 6 * b.master;
+            let am = b.inverse_mass(&self.trial.r[b.master], &c[d..d + 6], &f[d..d + 6]);
+            a[d..d + 6].copy_from_slice(am.as_slice());
+        }
+    }
+
+    fn mass_product(&self, v: &[f64], out: &mut [f64]) {
+        for ((o, m), v) in out.iter_mut().zip(&self.mass).zip(v) {
+            *o = m * v;
+        }
+        for b in &self.rigid {
+            let d = 6 * b.master;
+            let vm = nalgebra::Vector6::from_column_slice(&v[d..d + 6]);
+            let p = b.mass6(&self.trial.r[b.master]) * vm;
+            out[d..d + 6].copy_from_slice(p.as_slice());
+        }
+    }
+
+    fn nondiagonal_mass(&self, out: &mut Vec<Triplet<usize, usize, f64>>) {
+        out.clear();
+        for b in &self.rigid {
+            let d = 6 * b.master;
+            let m6 = b.mass6(&self.trial.r[b.master]);
+            for i in 0..6 {
+                for j in 0..6 {
+                    let v = if i == j { m6[(i, j)] - self.mass[d + i] } else { m6[(i, j)] };
+                    if v != 0.0 {
+                        out.push(Triplet::new(d + i, d + j, v));
+                    }
+                }
+            }
+        }
+    }
+
+    fn explicit_drift(&self, dt: f64, v_half: &mut [f64], du: &mut [f64]) {
+        let (x, r) = (&self.trial.x, &self.trial.r);
+        for b in &self.rigid {
+            let m = b.master;
+            let d = 6 * m;
+            let cons = &self.constrained[d..d + 6];
+            let (dx, r1) = b.drift(&r[m], cons, dt, &mut v_half[d..d + 6], &du[d..d + 6]);
+            let w = crate::elements::rotation::log(&(r1 * r[m].transpose()));
+            du[d..d + 3].copy_from_slice(dx.as_slice());
+            du[d + 3..d + 6].copy_from_slice(w.as_slice());
+            let xm1 = x[m] + dx;
+            for (k, &s) in b.slaves.iter().enumerate() {
+                let dxs = b.slave(k, &xm1, &r1).0 - x[s];
+                du[6 * s..6 * s + 3].copy_from_slice(dxs.as_slice());
+                du[6 * s + 3..6 * s + 6].copy_from_slice(w.as_slice());
+                for c in 0..6 {
+                    v_half[6 * s + c] = du[6 * s + c] / dt;
+                }
+            }
+        }
+    }
+
+    fn dependent_motion(&self, v: &mut [f64], a: &mut [f64]) {
+        let x = &self.trial.x;
+        let v3 = |v: &[f64], i: usize| Vector3::new(v[i], v[i + 1], v[i + 2]);
+        for b in &self.rigid {
+            let d = 6 * b.master;
+            let (vm, w, am, al) = (v3(v, d), v3(v, d + 3), v3(a, d), v3(a, d + 3));
+            for &s in &b.slaves {
+                let r = x[s] - x[b.master];
+                let vs = vm + w.cross(&r);
+                let acc = am + al.cross(&r) + w.cross(&w.cross(&r));
+                v[6 * s..6 * s + 3].copy_from_slice(vs.as_slice());
+                v[6 * s + 3..6 * s + 6].copy_from_slice(w.as_slice());
+                a[6 * s..6 * s + 3].copy_from_slice(acc.as_slice());
+                a[6 * s + 3..6 * s + 6].copy_from_slice(al.as_slice());
+            }
+        }
+    }
+
+    fn commit(&mut self) {
+        self.committed.clone_from(&self.trial);
+        if let Some(b) = self.bt4.as_mut().filter(|b| b.evaluated) {
+            b.shells.commit();
+            b.evaluated = false;
+        }
+    }
+
+    fn revert(&mut self) {
+        self.fint_valid = false;
+        self.trial.clone_from(&self.committed);
+        if let Some(b) = &mut self.bt4 {
+            b.evaluated = false;
+        }
+    }
+
+    fn has_tangent(&self) -> bool {
+        self.bt4.is_none()
+    }
+
+    fn stable_dt(&self) -> f64 {
+        self.dt_crit
+    }
+
+    fn displacement(&self, out: &mut [[f64; 3]]) {
+        for (n, o) in out.iter_mut().enumerate() {
+            let d = self.trial.x[n] - self.x0[n];
+            *o = [d.x, d.y, d.z];
+        }
+    }
+}
+
+impl FeModel {
+    /// External force before the rigid reduction (loads on every node as given).
+    fn external_unreduced(&self, t: f64, f: &mut [f64]) {
         f.copy_from_slice(&self.external);
         for (d, v, c) in &self.point_loads {
             f[*d] += v * c.at(t);
@@ -506,7 +916,7 @@ impl Model for FeModel {
             let s = c.at(t);
             for n in 0..self.x0.len() {
                 for k in 0..3 {
-                    f[6 * n + k] += self.mass[6 * n + k] * g[k] * s;
+                    f[6 * n + k] += self.node_mass[6 * n + k] * g[k] * s;
                 }
             }
         }
@@ -526,7 +936,7 @@ impl Model for FeModel {
     }
 
     /// The tangent of the elements; BT4 shells add nothing (`has_tangent` is then `false`).
-    fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
+    fn element_tangent(&self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
         out.clear();
         let pc = self.cell_pressure(t);
         let pe: Vec<f64> = self.element_cell.iter().map(|&c| pc[c]).collect();
@@ -561,34 +971,64 @@ impl Model for FeModel {
             }
         }
     }
+}
 
-    fn commit(&mut self) {
+/// The committed state of a model as checkpoints hold it, and its restoration.
+impl FeModel {
+    /// Accumulated spins of the committed configuration (checkpoints).
+    pub fn committed_spins(&self) -> &[Vector3<f64>] {
+        &self.committed.spin_sum
+    }
+
+    /// The explicit BT4 shells, if any (their state and output fields).
+    pub fn bt4(&self) -> Option<&Bt4> {
+        self.bt4.as_ref().map(|b| &b.shells)
+    }
+
+    /// Restores a committed state (configuration, accumulated spins, the material state of
+    /// the elements as `element_state` reads it, concatenated, and the BT4 state) and commits
+    /// it, so that a run resumes bitwise; refuses arrays of another model.
+    pub fn restore_committed(
+        &mut self,
+        x: &[Vector3<f64>],
+        r: &[Matrix3<f64>],
+        spins: &[Vector3<f64>],
+        material: &[f64],
+        bt4: Option<crate::elements::bt4::Bt4State>,
+    ) -> Result<(), String> {
+        let nn = self.x0.len();
+        if x.len() != nn || r.len() != nn || spins.len() != nn {
+            return Err(format!("a configuration of another mesh ({} nodes, not {nn})", x.len()));
+        }
+        if material.len() != self.committed.material.len() {
+            return Err(format!(
+                "{} material state values, the model holds {}",
+                material.len(),
+                self.committed.material.len()
+            ));
+        }
+        match (&mut self.bt4, bt4) {
+            (Some(b), Some(s)) => {
+                let have = b.shells.state();
+                if (s.stress.len(), s.alpha.len(), s.hourglass.len())
+                    != (have.stress.len(), have.alpha.len(), have.hourglass.len())
+                {
+                    return Err("a BT4 state of another mesh or thickness rule".into());
+                }
+                b.shells.set_state(s);
+                b.evaluated = false;
+            }
+            (None, None) => {}
+            (Some(_), None) => return Err("the model has BT4 shells, the state has none".into()),
+            (None, Some(_)) => return Err("the state has BT4 shells, the model has none".into()),
+        }
+        let s = &mut self.trial;
+        s.x.copy_from_slice(x);
+        s.r.copy_from_slice(r);
+        s.spin_sum.copy_from_slice(spins);
+        s.material.copy_from_slice(material);
         self.committed.clone_from(&self.trial);
-        if let Some(b) = self.bt4.as_mut().filter(|b| b.evaluated) {
-            b.shells.commit();
-            b.evaluated = false;
-        }
-    }
-
-    fn revert(&mut self) {
-        self.trial.clone_from(&self.committed);
-        if let Some(b) = &mut self.bt4 {
-            b.evaluated = false;
-        }
-    }
-
-    fn has_tangent(&self) -> bool {
-        self.bt4.is_none()
-    }
-
-    fn stable_dt(&self) -> f64 {
-        self.dt_crit
-    }
-
-    fn displacement(&self, out: &mut [[f64; 3]]) {
-        for (n, o) in out.iter_mut().enumerate() {
-            let d = self.trial.x[n] - self.x0[n];
-            *o = [d.x, d.y, d.z];
-        }
+        self.fint_valid = false;
+        Ok(())
     }
 }

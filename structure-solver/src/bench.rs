@@ -1,6 +1,7 @@
 //! `structure-solver bench`: the speed of the explicit BT4 kernel (element updates per second
 //! on one core, J2 with the plane-stress return at 5 thickness points) and of an implicit
-//! Newmark step of a 10k-node MITC4 shell, printed as JSON (DESIGN §6, §7).
+//! Newmark step of a 10k-node MITC4 shell with the time of each piece of a Newton iteration
+//! (internal force, tangent, factorisation, solve), printed as JSON (DESIGN §6, §7).
 
 use std::time::Instant;
 
@@ -41,6 +42,73 @@ pub struct ImplicitBench {
     pub newton_iterations: usize,
     pub seconds_per_step: f64,
     pub seconds_per_newton_iteration: f64,
+    /// One Newton iteration's pieces at the final configuration.
+    pub pieces: IterationPieces,
+}
+
+/// Seconds spent in each piece of a Newton iteration (best of three).
+#[derive(Debug, Serialize)]
+pub struct IterationPieces {
+    pub internal_force: f64,
+    pub tangent_assembly: f64,
+    /// The element tangents alone, on one thread.
+    pub element_tangents_one_thread: f64,
+    pub factorisation: f64,
+    pub solve: f64,
+    /// Triplets of the assembled tangent (before summing duplicates).
+    pub tangent_triplets: usize,
+}
+
+/// Times each piece of a Newton iteration of `model` at its current configuration.
+fn pieces(model: &mut FeModel) -> anyhow::Result<IterationPieces> {
+    use crate::linsolve::FreeSolver;
+    use crate::model::Model;
+    use faer::linalg::solvers::Solve;
+    let best = |f: &mut dyn FnMut()| {
+        (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let n = model.n_dof();
+    let mut fi = vec![0.0; n];
+    let internal_force = best(&mut || model.internal_force(&mut fi));
+    let mut triplets = Vec::new();
+    let tangent_assembly = best(&mut || model.tangent(0.0, &mut triplets));
+    let element_tangents_one_thread = best(&mut || {
+        let (x, r) = (model.positions(), model.rotations());
+        for (i, e) in model.elements().iter().enumerate() {
+            let xe: Vec<_> = e.nodes.iter().map(|&n| x[n]).collect();
+            let re: Vec<_> = e.nodes.iter().map(|&n| r[n]).collect();
+            std::hint::black_box(e.tangent(&xe, &re, model.element_state(i), None));
+        }
+    });
+    let mass = model.lumped_mass().to_vec();
+    let mut solver = FreeSolver::new(model);
+    // the first factorisation makes the symbolic analysis
+    let lu = solver.factor(&triplets, 1.0, Some((1e8, &mass)))?;
+    let mut result = Ok(());
+    let factorisation = best(&mut || {
+        if let Err(e) = solver.factor(&triplets, 1.0, Some((1e8, &mass))) {
+            result = Err(e);
+        }
+    });
+    result?;
+    let rhs = solver.free.gather(&fi);
+    let solve = best(&mut || {
+        std::hint::black_box(lu.solve(&rhs));
+    });
+    Ok(IterationPieces {
+        internal_force,
+        tangent_assembly,
+        element_tangents_one_thread,
+        factorisation,
+        solve,
+        tangent_triplets: triplets.len(),
+    })
 }
 
 fn steel() -> J2 {
@@ -129,6 +197,7 @@ pub fn implicit(n: usize, steps: usize) -> anyhow::Result<ImplicitBench> {
         its += im.step(&mut model, 1e-4, None)?.iterations.max(1);
     }
     let secs = t0.elapsed().as_secs_f64();
+    let pieces = pieces(&mut model)?;
     Ok(ImplicitBench {
         nodes,
         dofs: 6 * nodes,
@@ -136,6 +205,7 @@ pub fn implicit(n: usize, steps: usize) -> anyhow::Result<ImplicitBench> {
         newton_iterations: its,
         seconds_per_step: secs / steps as f64,
         seconds_per_newton_iteration: secs / its as f64,
+        pieces,
     })
 }
 

@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail};
-use interface_protocol::case::{Case, Scheme};
+use interface_protocol::case::{Case, Integrator, Scheme};
 use interface_protocol::coupling::{
     a6_acceleration_estimate, a6_prediction, c0_load_average, c0_prediction, c0_start_prediction,
     kick,
@@ -29,10 +29,11 @@ use interface_protocol::participant::{failure_code, serve, Failure, Handler, Pro
 
 use interface_protocol::io::progress::Progress as Bar;
 
-use crate::assembly::RotaryInertia;
+use crate::assembly::{FeModel, RotaryInertia};
 use crate::mesh::{CellKind, Mesh};
+use crate::model::Model;
 use crate::output::FieldOutput;
-use crate::restart::{save_dynamics, Restorable, PART};
+use crate::restart::{save_dynamics, save_state, PART};
 use crate::run::{build, need, section, Structure};
 use crate::time::{critical_dt, CentralDifference, Implicit, ImplicitScheme};
 
@@ -106,7 +107,7 @@ fn velocity<'a>(stepper: &'a Option<Stepper>, v0: &'a [f64]) -> &'a [f64] {
 /// The structure through the coupling sequence.
 pub struct Participant {
     scheme: Scheme,
-    model: Box<dyn Restorable>,
+    model: FeModel,
     wet: WetSurface,
     /// Reference positions of all nodes.
     x0: Vec<[f64; 3]>,
@@ -155,20 +156,23 @@ impl Participant {
         let s = section(case)?;
         let scheme = case.coupling.scheme;
         let explicit = scheme != Scheme::A6;
-        let expected = if explicit { "central_difference" } else { "midpoint" };
-        if let Some(i) = s.integrator.as_deref() {
+        let expected = if explicit { Integrator::CentralDifference } else { Integrator::Midpoint };
+        if let Some(i) = s.integrator {
             if i != expected {
                 bail!(
-                    "{}: field `structure.integrator`: the {scheme:?} scheme integrates the structure with {expected}, got \"{i}\"",
-                    file.display()
+                    "{}: field `structure.integrator`: the {scheme:?} scheme integrates the structure with \"{}\", got \"{}\"",
+                    file.display(),
+                    expected.name(),
+                    i.name()
                 );
             }
         }
         let rotary = if explicit { RotaryInertia::Scaled } else { RotaryInertia::Physical };
-        let Structure { mesh, mut model, v0, element, thickness } = build(case, rotary)?;
-        if !explicit && element == "bt4" {
+        let Structure { mesh, mut model, v0, cells, length } = build(case, rotary)?;
+        if !explicit && !model.has_tangent() {
+            let field = if s.parts.is_empty() { "element" } else { "parts" };
             bail!(
-                "{}: field `structure.element`: bt4 is explicit; the A6 scheme needs element = \"mitc4\"",
+                "{}: field `structure.{field}`: bt4 shells are explicit; the A6 scheme needs mitc4 or dkt shells",
                 file.display()
             );
         }
@@ -176,7 +180,7 @@ impl Participant {
         let wet = wet_surface(&mesh, wet_name)
             .map_err(|e| anyhow!("{}: field `structure.wet_set`: {e}", file.display()))?;
         let dt_stable = if explicit {
-            critical_dt(model.as_mut(), 0.0, 100, 1e-9 * thickness).stable(1.0)
+            critical_dt(&mut model, 0.0, 100, 1e-9 * length).stable(1.0)
         } else {
             f64::INFINITY
         };
@@ -185,7 +189,7 @@ impl Participant {
         let names: Vec<&str> = s.probes.iter().map(|p| p.name.as_str()).collect();
         let probes = ProbeWriter::structure(dir.path(), &names)?;
         let n = model.n_dof();
-        let fields = FieldOutput::create(dir.path(), &mesh)?;
+        let fields = FieldOutput::create(dir.path(), &mesh, Some(cells))?;
         Ok(Participant {
             fields: Some(fields),
             fields_every: case.output.fields_every,
@@ -323,7 +327,7 @@ impl Participant {
         match self.scheme {
             Scheme::A6 => {
                 let im = Implicit::new(
-                    self.model.as_mut(),
+                    &mut self.model,
                     ImplicitScheme::Midpoint,
                     0.0,
                     v0,
@@ -333,7 +337,7 @@ impl Participant {
                 self.stepper = Some(Stepper::Midpoint(im));
             }
             Scheme::Css | Scheme::C0 => {
-                let cd = CentralDifference::new(self.model.as_mut(), 0.0, v0, Some(&self.load));
+                let cd = CentralDifference::new(&mut self.model, 0.0, v0, Some(&self.load));
                 if self.scheme == Scheme::C0 {
                     let s = &cd.state;
                     kick(&s.v, &s.a, -0.5 * dt, &mut self.v_half_prev);
@@ -366,7 +370,7 @@ impl Participant {
                     self.f_half.copy_from_slice(&self.load);
                 }
                 let Some(Stepper::Explicit(cd)) = self.stepper.as_mut() else { unreachable!() };
-                cd.advance_positions(self.model.as_mut(), dt);
+                cd.advance_positions(&mut self.model, dt);
                 self.displacement_into_up();
                 self.scratch.copy_from_slice(&self.up);
                 let Some(Stepper::Explicit(cd)) = self.stepper.as_ref() else { unreachable!() };
@@ -412,17 +416,17 @@ impl Participant {
         self.read_loads(ep)?;
         match self.stepper.as_mut() {
             Some(Stepper::Explicit(cd)) if self.scheme == Scheme::Css => {
-                cd.step(self.model.as_mut(), dt, Some(&self.load));
+                cd.step(&mut self.model, dt, Some(&self.load));
             }
             Some(Stepper::Explicit(cd)) => {
                 c0_load_average(&self.f_half, &self.load, &mut self.scratch);
-                cd.complete(self.model.as_mut(), dt, Some(&self.scratch));
+                cd.complete(&mut self.model, dt, Some(&self.scratch));
                 self.v_half_prev.copy_from_slice(&cd.v_half);
                 self.f_half.copy_from_slice(&self.load);
             }
             Some(Stepper::Midpoint(im)) => {
                 self.scratch.copy_from_slice(&im.state.v);
-                im.step(self.model.as_mut(), dt, Some(&self.load)).map_err(|e| {
+                im.step(&mut self.model, dt, Some(&self.load)).map_err(|e| {
                     Failure::new(failure_code::SOLVER, format!("step {n} to t = {t_to}: {e}"))
                 })?;
                 a6_acceleration_estimate(&im.state.v, &self.scratch, dt, &mut self.a_hat);
@@ -436,10 +440,10 @@ impl Participant {
         }
         self.t = t_to;
         self.steps = n + 1;
-        let (fields, model) = (self.fields.as_mut(), self.model.as_ref());
+        let (fields, model) = (self.fields.as_mut(), &self.model);
         let v = velocity(&self.stepper, &self.v0);
         if let Some(f) = fields {
-            f.gather(t_to, model, v).map_err(|e| {
+            f.gather(t_to, model, Some(model), v).map_err(|e| {
                 Failure::new(
                     failure_code::SOLVER,
                     format!("{e} (step {n}, Δt = {dt:.3e}, stable step {:.3e})", self.dt_stable),
@@ -492,7 +496,7 @@ impl Participant {
             bail!("a checkpoint needs START first");
         };
         let mut ck = Checkpoint::new(self.steps, self.t);
-        self.model.save_state(&mut ck)?;
+        save_state(&self.model, &mut ck)?;
         save_dynamics(&mut ck, d)?;
         ck.put("coupling.f_half", self.f_half.clone())?;
         ck.put("coupling.v_half_prev", self.v_half_prev.clone())?;
@@ -531,7 +535,7 @@ impl Handler<StructureEndpoint> for Participant {
         self.publish_current(ep, 0, 0.0, 0.0)?;
         self.write_probes()?;
         if let Some(f) = self.fields.as_mut() {
-            f.gather(0.0, self.model.as_ref(), &self.v0)
+            f.gather(0.0, &self.model, Some(&self.model), &self.v0)
                 .map_err(|e| Failure::new(failure_code::SOLVER, format!("initial state: {e}")))?;
         }
         self.write_fields()?;

@@ -54,4 +54,41 @@ pub trait Model: Send {
 
     /// Current displacement of each node (translations only), node-major `[ux, uy, uz]`.
     fn displacement(&self, out: &mut [[f64; 3]]);
+
+    /// Accelerations `a = M⁻¹ f` on the free dofs with mass, 0 elsewhere. The default is the
+    /// lumped diagonal; models with rigid bodies solve each master's 6x6 block (mass, offset
+    /// centre and full inertia tensor in the current orientation).
+    fn apply_inverse_mass(&self, f: &[f64], a: &mut [f64]) {
+        let (m, c) = (self.lumped_mass(), self.constrained());
+        for (i, a) in a.iter_mut().enumerate() {
+            *a = if c[i] || m[i] <= 0.0 { 0.0 } else { f[i] / m[i] };
+        }
+    }
+
+    /// `out = M v` with the full mass matrix (lumped diagonal by default).
+    fn mass_product(&self, v: &[f64], out: &mut [f64]) {
+        for ((o, m), v) in out.iter_mut().zip(self.lumped_mass()).zip(v) {
+            *o = m * v;
+        }
+    }
+
+    /// The entries of the mass matrix beyond the diagonal `lumped_mass()` (the mass matrix
+    /// is `diag(lumped_mass) + these`), as triplets in the current configuration; none by
+    /// default.
+    fn nondiagonal_mass(&self, out: &mut Vec<Triplet<usize, usize, f64>>) {
+        out.clear();
+    }
+
+    /// The drift of explicit central differences over `dt` for dofs whose motion is not
+    /// `du = dt v_half` (rigid bodies: the free rigid-body flow of the master at constant
+    /// momentum, slaves following). On entry `du = dt v_half` on free dofs and the prescribed
+    /// increment on constrained ones, `v_half` the velocity after the first kick; the model may
+    /// rewrite both for dofs it owns (`v_half` then holds the velocity at the end
+    /// configuration with the same momentum). Nothing by default.
+    fn explicit_drift(&self, _dt: f64, _v_half: &mut [f64], _du: &mut [f64]) {}
+
+    /// Writes the velocities and accelerations of dependent dofs from the independent ones
+    /// in the current configuration (rigid slaves: `v = v_m + ω × r`,
+    /// `a = a_m + α × r + ω × (ω × r)`). Nothing by default.
+    fn dependent_motion(&self, _v: &mut [f64], _a: &mut [f64]) {}
 }

@@ -2,10 +2,13 @@
 //! of nodal displacement and velocity on the mesh (one cell block per cell kind), each step
 //! checked for the first non-finite value first (the stop names the field, node and time).
 //!
-//! Cell fields are those the model offers through `Restorable::element_fields` (BT4 shells: the
-//! largest von Mises stress and equivalent plastic strain through the thickness; `FeModel`
-//! runs, elastic as `structure-solver` builds them, carry nodal fields only).
+//! Cell fields ([`cell_fields`]): the largest equivalent plastic strain through the thickness
+//! of J2 shells and BT4 shells (tets: at their point), and the largest von Mises stress
+//! through the thickness of BT4 shells (0 on other cells); an elastic model without BT4 shells
+//! has nodal fields only. `structure_cells.csv` holds the final cell fields with the cell
+//! centroids.
 
+use std::io::Write;
 use std::path::Path;
 
 use interface_protocol::io::finite::{check_finite, Entity};
@@ -14,9 +17,91 @@ use interface_protocol::io::xdmf::{
     TimeSeriesWriter, Values,
 };
 
+use crate::assembly::FeModel;
+use crate::elements::ElementKind;
 use crate::mesh::{CellKind, Mesh};
 use crate::model::Model;
-use crate::restart::Restorable;
+
+/// Which mesh cells are the model's elements (`FeModel::elements`, in order) and which its
+/// BT4 shells (`FeModel::bt4`, in order), of `n_cells` (cells of no part carry zeros).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellMap {
+    pub elements: Vec<usize>,
+    pub bt4: Vec<usize>,
+    pub n_cells: usize,
+}
+
+/// Von Mises stress of a shell point `[σxx, σyy, σxy, σyz, σzx]` (σzz = 0).
+fn von_mises(s: [f64; 5]) -> f64 {
+    let [xx, yy, xy, yz, zx] = s;
+    (xx * xx - xx * yy + yy * yy + 3.0 * (xy * xy + yz * yz + zx * zx)).sqrt()
+}
+
+/// The committed cell fields of `model`, one value per mesh cell: `plastic_strain` when some
+/// element has a J2 state or the model has BT4 shells, `von_mises` when it has BT4 shells.
+pub fn cell_fields(model: &FeModel, map: &CellMap) -> Vec<(&'static str, Vec<f64>)> {
+    let n = map.n_cells;
+    let bt4 = model.bt4();
+    let has_state = (0..model.elements().len()).any(|e| !model.element_state(e).is_empty());
+    let mut out = Vec::new();
+    if has_state || bt4.is_some() {
+        let mut ep = vec![0.0; n];
+        for (e, &c) in map.elements.iter().enumerate() {
+            let st = model.element_state(e);
+            // J2 shells: [εp_xx, εp_yy, γp_xy, α] per point; tets: [εp (6), α].
+            let (first, stride) = match model.elements()[e].kind {
+                ElementKind::Quad4 | ElementKind::Tri3 => (3, 4),
+                ElementKind::Tet4 => (6, 7),
+                ElementKind::Beam2 => (0, 1),
+            };
+            ep[c] = st.iter().skip(first).step_by(stride).fold(0.0, |m: f64, v| m.max(*v));
+        }
+        if let Some(b) = bt4 {
+            let np = b.settings.rule.len();
+            for (e, &c) in map.bt4.iter().enumerate() {
+                ep[c] = (0..np).map(|p| b.plastic_strain(e, p)).fold(0.0, f64::max);
+            }
+        }
+        out.push(("plastic_strain", ep));
+    }
+    if let Some(b) = bt4 {
+        let np = b.settings.rule.len();
+        let mut vm = vec![0.0; n];
+        for (e, &c) in map.bt4.iter().enumerate() {
+            vm[c] = (0..np).map(|p| von_mises(b.stress(e, p))).fold(0.0, f64::max);
+        }
+        out.push(("von_mises", vm));
+    }
+    out
+}
+
+/// Writes `cell,x,y,z,<fields>`: the final cell fields at the cell centroids.
+pub fn write_cell_table(
+    path: &Path,
+    mesh: &Mesh,
+    model: &FeModel,
+    map: &CellMap,
+) -> anyhow::Result<()> {
+    let fields = cell_fields(model, map);
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    write!(w, "cell,x,y,z")?;
+    for (name, _) in &fields {
+        write!(w, ",{name}")?;
+    }
+    writeln!(w)?;
+    for (c, cell) in mesh.cells.iter().enumerate() {
+        let k = cell.nodes.len() as f64;
+        let x: [f64; 3] =
+            std::array::from_fn(|i| cell.nodes.iter().map(|&n| mesh.nodes[n][i]).sum::<f64>() / k);
+        write!(w, "{c},{:e},{:e},{:e}", x[0], x[1], x[2])?;
+        for (_, v) in &fields {
+            write!(w, ",{:e}", v[c])?;
+        }
+        writeln!(w)?;
+    }
+    w.flush()?;
+    Ok(())
+}
 
 /// The XDMF cell kind of a mesh cell kind.
 fn xdmf_kind(k: CellKind) -> XdmfKind {
@@ -33,14 +118,17 @@ pub struct FieldOutput {
     writer: TimeSeriesWriter,
     /// Mesh cell of each output cell (cells are written grouped by kind).
     cell_order: Vec<usize>,
+    /// The cells of the model's elements, when the series carries cell fields.
+    cells: Option<CellMap>,
     cell_fields: Vec<(&'static str, Vec<f64>)>,
     displacement: Vec<[f64; 3]>,
     velocity: Vec<[f64; 3]>,
 }
 
 impl FieldOutput {
-    /// Starts `structure.h5` + `structure.xdmf` in `dir` with the mesh's nodes and cells.
-    pub fn create(dir: &Path, mesh: &Mesh) -> anyhow::Result<FieldOutput> {
+    /// Starts `structure.h5` + `structure.xdmf` in `dir` with the mesh's nodes and cells; with
+    /// `cells`, each step also carries the cell fields of the model.
+    pub fn create(dir: &Path, mesh: &Mesh, cells: Option<CellMap>) -> anyhow::Result<FieldOutput> {
         let kinds = [CellKind::Line2, CellKind::Tri3, CellKind::Quad4, CellKind::Tet4];
         let conn: Vec<(CellKind, Vec<u32>)> = kinds
             .iter()
@@ -67,17 +155,27 @@ impl FieldOutput {
         Ok(FieldOutput {
             writer,
             cell_order,
+            cells,
             cell_fields: Vec::new(),
             displacement: vec![[0.0; 3]; n],
             velocity: vec![[0.0; 3]; n],
         })
     }
 
-    /// Loads the model's displacement and the translational velocities `v` (6 per node) and
-    /// checks both are finite.
-    pub fn gather(&mut self, t: f64, model: &dyn Restorable, v: &[f64]) -> anyhow::Result<()> {
+    /// Loads the model's displacement and the translational velocities `v` (6 per node), and
+    /// the cell fields of `fe` when the series carries them; checks all are finite.
+    pub fn gather(
+        &mut self,
+        t: f64,
+        model: &dyn Model,
+        fe: Option<&FeModel>,
+        v: &[f64],
+    ) -> anyhow::Result<()> {
         gather_nodal(t, model, v, &mut self.displacement, &mut self.velocity)?;
-        self.cell_fields = model.element_fields();
+        self.cell_fields = match (&self.cells, fe) {
+            (Some(map), Some(fe)) => cell_fields(fe, map),
+            _ => Vec::new(),
+        };
         for (name, values) in &mut self.cell_fields {
             check_finite(name, Entity::Element, t, &values[..])?;
             *values = self.cell_order.iter().map(|&c| values[c]).collect();

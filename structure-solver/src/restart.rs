@@ -1,38 +1,23 @@
-//! Checkpoints of the structure (DESIGN §6, §7): the model's configuration and element state and
-//! the integrator's velocities and accelerations, as named arrays of an
+//! Checkpoints of the structure (DESIGN §6, §7): the model's committed state and the
+//! integrator's velocities and accelerations, as named arrays of an
 //! `interface_protocol::io::checkpoint` file (`checkpoints/<tag>/structure.ckpt`).
 //!
-//! What each model holds: BT4 shells (`ShellModel`): committed positions, and per point the
-//! stresses, equivalent plastic strain and hourglass stresses. MITC4/DKT/beam/tet models
-//! (`FeModel`): positions, nodal rotation matrices and the committed J2 state per element;
-//! `FeModel` offers no setter for its material state nor for the accumulated spins of prescribed
-//! rotations, so a checkpoint with plastic state is refused at restart (elastic restarts are
-//! exact).
+//! The state of an `FeModel`: positions `x`, nodal rotation matrices `rotations`, accumulated
+//! spins `spins` (BT4 shells read their increments from them), the J2 state of every element
+//! `material`, and for BT4 shells per point the stresses, equivalent plastic strain and
+//! hourglass stresses (`bt4.*`). A restart restores all of it, so it reproduces the run
+//! bitwise.
 
 use interface_protocol::io::checkpoint::Checkpoint;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::assembly::FeModel;
 use crate::elements::bt4::Bt4State;
-use crate::explicit_shell::ShellModel;
 use crate::model::Model;
 use crate::time::Dynamics;
 
 /// The part name of the structure's checkpoint files.
 pub const PART: &str = "structure";
-
-/// A model whose state can be saved and restored.
-pub trait Restorable: Model {
-    /// Puts the committed configuration and element state into `ck`.
-    fn save_state(&self, ck: &mut Checkpoint) -> anyhow::Result<()>;
-    /// Restores what `save_state` wrote and commits it.
-    fn restore_state(&mut self, ck: &Checkpoint) -> anyhow::Result<()>;
-    /// Per-element output fields (one value per mesh cell, in mesh order) of the committed
-    /// state: name and values; none by default.
-    fn element_fields(&self) -> Vec<(&'static str, Vec<f64>)> {
-        Vec::new()
-    }
-}
 
 /// `ck`'s array `name` with exactly `n` values, or an error naming it.
 fn sized<'a>(ck: &'a Checkpoint, name: &str, n: usize) -> anyhow::Result<&'a [f64]> {
@@ -47,81 +32,55 @@ fn sized<'a>(ck: &'a Checkpoint, name: &str, n: usize) -> anyhow::Result<&'a [f6
     Ok(a)
 }
 
-impl Restorable for ShellModel {
-    fn save_state(&self, ck: &mut Checkpoint) -> anyhow::Result<()> {
-        ck.put("x", self.committed_positions().as_flattened().to_vec())?;
-        let s = self.bt4.state();
+fn flat(v: &[Vector3<f64>]) -> Vec<f64> {
+    v.iter().flat_map(|p| [p.x, p.y, p.z]).collect()
+}
+
+fn vectors(a: &[f64]) -> Vec<Vector3<f64>> {
+    a.chunks_exact(3).map(Vector3::from_column_slice).collect()
+}
+
+/// Puts the committed configuration and element state of `model` into `ck`.
+pub fn save_state(model: &FeModel, ck: &mut Checkpoint) -> anyhow::Result<()> {
+    ck.put("x", flat(model.positions()))?;
+    let r: Vec<f64> = model.rotations().iter().flat_map(|m| m.as_slice().to_vec()).collect();
+    ck.put("rotations", r)?;
+    ck.put("spins", flat(model.committed_spins()))?;
+    let material: Vec<f64> =
+        (0..model.elements().len()).flat_map(|e| model.element_state(e).to_vec()).collect();
+    ck.put("material", material)?;
+    if let Some(b) = model.bt4() {
+        let s = b.state();
         ck.put("bt4.stress", s.stress.clone())?;
         ck.put("bt4.plastic_strain", s.alpha.clone())?;
         ck.put("bt4.hourglass", s.hourglass.clone())?;
-        Ok(())
     }
-
-    fn restore_state(&mut self, ck: &Checkpoint) -> anyhow::Result<()> {
-        let x = sized(ck, "x", 3 * self.n_nodes())?;
-        let s = self.bt4.state();
-        let state = Bt4State {
-            stress: sized(ck, "bt4.stress", s.stress.len())?.to_vec(),
-            alpha: sized(ck, "bt4.plastic_strain", s.alpha.len())?.to_vec(),
-            hourglass: sized(ck, "bt4.hourglass", s.hourglass.len())?.to_vec(),
-        };
-        self.set_positions(x.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect());
-        self.bt4.set_state(state);
-        self.commit();
-        Ok(())
-    }
-
-    /// The largest von Mises stress and equivalent plastic strain through each shell's thickness.
-    fn element_fields(&self) -> Vec<(&'static str, Vec<f64>)> {
-        let (ne, np) = (self.bt4.n_elements(), self.bt4.settings.rule.len());
-        let max_over = |f: &dyn Fn(usize, usize) -> f64| -> Vec<f64> {
-            (0..ne).map(|e| (0..np).map(|p| f(e, p)).fold(0.0, f64::max)).collect()
-        };
-        vec![
-            ("von_mises", max_over(&|e, p| von_mises(self.bt4.stress(e, p)))),
-            ("plastic_strain", max_over(&|e, p| self.bt4.plastic_strain(e, p))),
-        ]
-    }
+    Ok(())
 }
 
-/// Von Mises stress of a shell point `[σxx, σyy, σxy, σyz, σzx]` (σzz = 0).
-fn von_mises(s: [f64; 5]) -> f64 {
-    let [xx, yy, xy, yz, zx] = s;
-    (xx * xx - xx * yy + yy * yy + 3.0 * (xy * xy + yz * yz + zx * zx)).sqrt()
-}
-
-impl Restorable for FeModel {
-    fn save_state(&self, ck: &mut Checkpoint) -> anyhow::Result<()> {
-        let x: Vec<f64> = self.positions().iter().flat_map(|p| [p.x, p.y, p.z]).collect();
-        let r: Vec<f64> = self.rotations().iter().flat_map(|m| m.as_slice().to_vec()).collect();
-        ck.put("x", x)?;
-        ck.put("rotations", r)?;
-        let material: Vec<f64> =
-            (0..self.elements().len()).flat_map(|e| self.element_state(e).to_vec()).collect();
-        ck.put("material", material)?;
-        Ok(())
-    }
-
-    fn restore_state(&mut self, ck: &Checkpoint) -> anyhow::Result<()> {
-        let n = self.n_nodes();
-        let x: Vec<Vector3<f64>> =
-            sized(ck, "x", 3 * n)?.chunks_exact(3).map(Vector3::from_column_slice).collect();
-        let r: Vec<Matrix3<f64>> = sized(ck, "rotations", 9 * n)?
-            .chunks_exact(9)
-            .map(Matrix3::from_column_slice)
-            .collect();
-        // `FeModel` can read its J2 state but not set it: a yielded model cannot resume exactly.
-        if let Some(i) = ck.f64("material")?.iter().position(|&v| v != 0.0) {
-            anyhow::bail!(
-                "checkpoint at step {}: the model has plastic state (value {i} is nonzero) and \
-                 FeModel cannot restore material state; restart from a checkpoint before yield",
-                ck.step
-            );
+/// Restores what [`save_state`] wrote into `model` and commits it.
+pub fn restore_state(model: &mut FeModel, ck: &Checkpoint) -> anyhow::Result<()> {
+    let n = model.n_nodes();
+    let x = vectors(sized(ck, "x", 3 * n)?);
+    let r: Vec<Matrix3<f64>> =
+        sized(ck, "rotations", 9 * n)?.chunks_exact(9).map(Matrix3::from_column_slice).collect();
+    let spins = vectors(sized(ck, "spins", 3 * n)?);
+    let n_state: usize = (0..model.elements().len()).map(|e| model.element_state(e).len()).sum();
+    let material = sized(ck, "material", n_state)?;
+    let bt4 = match model.bt4() {
+        Some(b) => {
+            let s = b.state();
+            Some(Bt4State {
+                stress: sized(ck, "bt4.stress", s.stress.len())?.to_vec(),
+                alpha: sized(ck, "bt4.plastic_strain", s.alpha.len())?.to_vec(),
+                hourglass: sized(ck, "bt4.hourglass", s.hourglass.len())?.to_vec(),
+            })
         }
-        self.set_configuration(&x, &r);
-        self.commit();
-        Ok(())
-    }
+        None => None,
+    };
+    model
+        .restore_committed(&x, &r, &spins, material, bt4)
+        .map_err(|e| anyhow::anyhow!("checkpoint at step {}: {e}", ck.step))
 }
 
 /// Puts the integrator state (`t` is the checkpoint's time).

@@ -1,12 +1,12 @@
 //! Static equilibrium of a `Model`: load-stepped Newton-Raphson with a sparse direct solve
-//! (`linsolve`: faer LU on the free dofs) and step cutting, and displacement control (Batoz & Dhatt 1979)
-//! for paths with limit points in load. Pseudo-time `t` is the load factor.
+//! (`linsolve`, on the free dofs) and step cutting, displacement control (Batoz & Dhatt 1979)
+//! and cylindrical arc length (Crisfield 1981) for paths with limit points in load.
+//! Pseudo-time `t` is the load factor.
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Lu;
 use faer::Mat;
 
-use crate::linsolve::{FreeDofs, FreeSolver};
+use crate::linsolve::{Factor, FreeDofs, FreeSolver};
 use crate::model::Model;
 
 /// Newton settings.
@@ -51,11 +51,7 @@ pub enum StaticsError {
 }
 
 /// Factors the free-free block of the model's tangent at `t`.
-fn factor(
-    model: &mut dyn Model,
-    t: f64,
-    solver: &mut FreeSolver,
-) -> Result<Lu<usize, f64>, StaticsError> {
+fn factor(model: &mut dyn Model, t: f64, solver: &mut FreeSolver) -> Result<Factor, StaticsError> {
     let mut trip = Vec::new();
     model.tangent(t, &mut trip);
     solver.factor(&trip, 1.0, None).map_err(|e| StaticsError::Singular(e.0))
@@ -252,4 +248,166 @@ pub fn displacement_control(
         }
     }
     Ok(out)
+}
+
+/// Settings of the arc-length path following.
+#[derive(Debug, Clone, Copy)]
+pub struct ArcLengthSettings {
+    /// Residual tolerance and iterations per step; `max_cuts` halvings of the arc length of a
+    /// step that fails.
+    pub newton: NewtonSettings,
+    /// Arc length of the first step: the norm of the free-dof increment of a step.
+    pub initial: f64,
+    /// Bounds of the arc length.
+    pub min: f64,
+    pub max: f64,
+    /// The arc length of the next step is scaled by `√(desired / used)` iterations (Crisfield
+    /// 1991, §9.5), within `[min, max]`.
+    pub desired_iterations: usize,
+    /// Steps taken at most.
+    pub max_steps: usize,
+    /// Load factor of the model's committed state (0 from the unloaded state; the last `t`
+    /// of a `load_steps` run to continue from it).
+    pub start: f64,
+}
+
+/// Cylindrical arc length (Crisfield 1981, Comput. Struct. 13:55; *Non-linear Finite Element
+/// Analysis of Solids and Structures* 1991, §9.3): load factor `λ` and displacements advance
+/// together with `|Δu|₂ = Δl` on the free dofs, the load scaling as in
+/// [`displacement_control`] (`f_ext(λ)` linear in `t`; prescribed dofs fixed). The predictor
+/// is the tangent solution `δu_t = K⁻¹ f_ext(1)` with the sign of its product with the previous
+/// step's increment (it turns at limit points, where `det K` changes sign); each corrector
+/// solves `K δu_r = r`, `K δu_t = f_ext(1)` and the constraint's quadratic for `δλ`, taking the
+/// root whose increment makes the smaller angle with the step's increment so far. A step that
+/// fails (no real root, no convergence) is retried with half the arc length. `on_step` sees each
+/// converged state (its `t` is `λ`) and returns `false` to stop.
+pub fn arc_length(
+    model: &mut dyn Model,
+    s: &ArcLengthSettings,
+    mut on_step: impl FnMut(&mut dyn Model, Converged) -> bool,
+) -> Result<Vec<Converged>, StaticsError> {
+    if !model.has_tangent() {
+        return Err(StaticsError::NoTangent);
+    }
+    let mut solver = FreeSolver::new(model);
+    let mut lambda = s.start;
+    let mut dl = s.initial;
+    let mut previous: Option<Vec<f64>> = None;
+    let mut out = Vec::new();
+    for _ in 0..s.max_steps {
+        let mut cuts = 0;
+        let (c, inc) = loop {
+            match arc_step(model, &mut solver, lambda, dl, previous.as_deref(), &s.newton) {
+                Ok(done) => break done,
+                Err(res) => {
+                    model.revert();
+                    cuts += 1;
+                    if cuts > s.newton.max_cuts || dl * 0.5 < s.min {
+                        return Err(StaticsError::NoConvergence {
+                            from: lambda,
+                            to: lambda,
+                            cuts,
+                            residual: res,
+                        });
+                    }
+                    dl *= 0.5;
+                }
+            }
+        };
+        model.commit();
+        lambda = c.t;
+        previous = Some(inc);
+        out.push(c);
+        if !on_step(&mut *model, c) {
+            break;
+        }
+        let ratio = s.desired_iterations.max(1) as f64 / c.iterations.max(1) as f64;
+        dl = (dl * ratio.sqrt()).clamp(s.min, s.max);
+    }
+    Ok(out)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The entries of a free column.
+fn column(m: &Mat<f64>) -> Vec<f64> {
+    (0..m.nrows()).map(|i| m[(i, 0)]).collect()
+}
+
+/// One arc-length step of length `dl` from the committed state at `lambda`; returns the
+/// converged state and the step's free-dof increment, or the relative residual on failure.
+fn arc_step(
+    model: &mut dyn Model,
+    solver: &mut FreeSolver,
+    lambda: f64,
+    dl: f64,
+    previous: Option<&[f64]>,
+    s: &NewtonSettings,
+) -> Result<(Converged, Vec<f64>), f64> {
+    let n = model.n_dof();
+    let fd = solver.free.clone();
+    let (mut r, mut fref, mut du) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    // predictor
+    model.external_force(1.0, &mut fref);
+    let lu = factor(model, lambda, solver).map_err(|_| f64::INFINITY)?;
+    let mut ut = fd.gather(&fref);
+    lu.solve_in_place(ut.as_mut());
+    let ut = column(&ut);
+    let norm = dot(&ut, &ut).sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(f64::INFINITY);
+    }
+    let sign = match previous {
+        Some(p) if dot(p, &ut) < 0.0 => -1.0,
+        _ => 1.0,
+    };
+    let mut dlam = sign * dl / norm;
+    let mut inc: Vec<f64> = ut.iter().map(|v| dlam * v).collect();
+    fd.scatter(&Mat::from_fn(inc.len(), 1, |i, _| inc[i]), &mut du);
+    model.apply_increment(&du);
+    let mut last = f64::INFINITY;
+    for it in 0..=s.max_iter {
+        let (rn, scale) = residual(model, lambda + dlam, &fd, &mut r);
+        last = rn / scale;
+        if !last.is_finite() {
+            break;
+        }
+        if last <= s.tol {
+            return Ok((Converged { t: lambda + dlam, iterations: it, residual: last }, inc));
+        }
+        if it == s.max_iter {
+            break;
+        }
+        model.external_force(1.0, &mut fref);
+        let Ok(lu) = factor(model, lambda + dlam, solver) else { break };
+        let mut a = fd.gather(&r);
+        lu.solve_in_place(a.as_mut());
+        let mut b = fd.gather(&fref);
+        lu.solve_in_place(b.as_mut());
+        let (ur, ut) = (column(&a), column(&b));
+        // |inc + ur + δλ ut|² = dl²
+        let w: Vec<f64> = inc.iter().zip(&ur).map(|(x, y)| x + y).collect();
+        let (qa, qb, qc) = (dot(&ut, &ut), 2.0 * dot(&ut, &w), dot(&w, &w) - dl * dl);
+        let disc = qb * qb - 4.0 * qa * qc;
+        if !(disc >= 0.0 && qa > 0.0) {
+            break;
+        }
+        let q = -0.5 * (qb + qb.signum() * disc.sqrt());
+        let roots = [q / qa, if q != 0.0 { qc / q } else { q / qa }];
+        let angle = |d: f64| dot(&inc, &w) + d * dot(&inc, &ut);
+        let dlm = if angle(roots[0]) >= angle(roots[1]) { roots[0] } else { roots[1] };
+        let step: Vec<f64> = w.iter().zip(&ut).map(|(w, t)| w + dlm * t).collect();
+        du.fill(0.0);
+        let delta = Mat::from_fn(step.len(), 1, |i, _| step[i] - inc[i]);
+        fd.scatter(&delta, &mut du);
+        if du.iter().any(|v| !v.is_finite()) {
+            break;
+        }
+        model.apply_increment(&du);
+        inc = step;
+        dlam += dlm;
+    }
+    Err(last)
 }

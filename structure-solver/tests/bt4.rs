@@ -2,10 +2,11 @@
 //! in 1000 explicit steps about a skew axis, the first bending frequency of a cantilever plate
 //! in free vibration, and the plastic hinge moment at 5 and 8 thickness points.
 
+use structure_solver::assembly::{FeModel, Part};
 use structure_solver::elements::bt4::{Bt4, Bt4Settings};
-use structure_solver::elements::RotaryInertia;
-use structure_solver::explicit_shell::ShellModel;
+use structure_solver::elements::{RotaryInertia, ShellSection};
 use structure_solver::material::{Elastic, ThicknessRule, J2};
+use structure_solver::mesh::{Cell, CellKind, Mesh};
 use structure_solver::model::Model;
 use structure_solver::time::{critical_dt, CentralDifference};
 
@@ -211,17 +212,17 @@ fn cantilever_plate_first_bending_frequency_matches_beam_theory() {
     let (l, b, h) = (1.0, 0.1, 0.02);
     let (nx, ny) = (24, 2);
     let (x0, conn) = plate(nx, ny, l, b, 0.0);
-    let n_el = conn.len();
-    let settings = Bt4Settings { rotary: RotaryInertia::Physical, ..Bt4Settings::default() };
     let mat = elastic(0.0);
-    let mut model = ShellModel::new(x0.clone(), Bt4::new(conn, vec![h; n_el], mat, settings));
-    for (i, p) in x0.iter().enumerate() {
-        if p[0] == 0.0 {
-            for k in 0..6 {
-                model.constrain(6 * i + k);
-            }
-        }
-    }
+    let cells = conn
+        .iter()
+        .map(|c| Cell { kind: CellKind::Quad4, nodes: c.iter().map(|&n| n as usize).collect() })
+        .collect();
+    let mesh = Mesh { nodes: x0.clone(), cells, ..Mesh::default() };
+    let e = mat.elastic;
+    let section = ShellSection { e: e.e, nu: e.nu, rho: e.rho, h };
+    let mut model = FeModel::new(&mesh, |_| Part::Bt4(section, None)).unwrap();
+    model.set_rotary_inertia(RotaryInertia::Physical);
+    model.fix(&mesh.nodes_where(|p| p[0] == 0.0), [true; 6]);
     let est = critical_dt(&mut model, 0.0, 200, 1e-9);
     let dt = 0.8 * est.element.min(est.power);
     // Initial velocity in the shape of the static tip-load deflection.

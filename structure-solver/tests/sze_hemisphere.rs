@@ -78,12 +78,13 @@ fn check(n: usize, triangles: bool, name: &str, tol_final: [f64; 2], tol_all: f6
     );
 }
 
-/// The flat MITC4 facets are stiffer than the paper's S4R on 16x16: u_A -1.9%, -v_B -3.2% at
-/// P_max (on 32x32 the same element gives -0.13% and -0.75%), so -v_B is held to 3.5% here.
+/// MITC4 quads on the paper's 16x16 mesh: -0.94% (u_A) and -1.42% (-v_B) at P_max, at most
+/// 1.42% over the table (with the full QM6 membrane, before `mitc4::MEMBRANE_STABILISATION`:
+/// -1.87% and -3.17%).
 #[test]
 #[cfg_attr(debug_assertions, ignore = "benchmark of several seconds: run with --release")]
 fn quads_16x16_follow_the_reference() {
-    check(16, false, "hemisphere quads 16x16", [0.02, 0.035], 0.035);
+    check(16, false, "hemisphere quads 16x16", [0.012, 0.016], 0.016);
 }
 
 /// Flat triangles lock in the hemisphere: twice as fine, 32x32 quads split in two.
@@ -91,4 +92,22 @@ fn quads_16x16_follow_the_reference() {
 #[cfg_attr(debug_assertions, ignore = "benchmark of several seconds: run with --release")]
 fn triangles_32x32_follow_the_reference() {
     check(32, true, "hemisphere triangles 32x32x2", [0.02, 0.02], 0.025);
+}
+
+/// Newton with the consistent tangent: each load step of the 16x16 quad table (P/P_max by
+/// 0.05) converges to a relative residual of 1e-9 in at most 10 iterations, 4 to 6 past the
+/// first quarter of the load (the same counts, step by step, as with the central-difference
+/// tangent `Element::tangent_by_differences`).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "benchmark of several seconds: run with --release")]
+fn quads_16x16_newton_iterations_stay_few() {
+    use structure_solver::statics::{load_steps, NewtonSettings};
+    let (_, mut m, _, _) = hemisphere(16, false);
+    let targets: Vec<f64> = ROWS.iter().map(|r| r.0).collect();
+    let s = NewtonSettings { tol: 1e-9, max_iter: 40, max_cuts: 0 };
+    let steps = load_steps(&mut m, &targets, &s, |_, _| {}).unwrap();
+    let its: Vec<usize> = steps.iter().map(|c| c.iterations).collect();
+    println!("hemisphere quads 16x16: Newton iterations per load step {its:?}");
+    assert!(its.iter().all(|&i| i <= 10), "Newton iterations {its:?}");
+    assert!(its[5..].iter().all(|&i| i <= 6), "Newton iterations {its:?}");
 }

@@ -217,6 +217,9 @@ fn field_at(text: &str, offset: usize) -> String {
 
 /// Line and column of a dotted key's definition, if it can be found in the text.
 fn locate_key(text: &str, dotted: &str) -> Option<(usize, usize)> {
+    if let Some((table, rest)) = dotted.split_once('[') {
+        return locate_entry_key(text, table, rest);
+    }
     let (table, key) = dotted.rsplit_once('.').unwrap_or(("", dotted));
     let mut current = String::new();
     let mut offset = 0;
@@ -230,6 +233,37 @@ fn locate_key(text: &str, dotted: &str) -> Option<(usize, usize)> {
         offset += l.len();
     }
     None
+}
+
+/// `table[k].key...` (`rest` = `k].key...`): the line of `key` in the `k`-th `[[table]]`
+/// entry, else the entry's header.
+fn locate_entry_key(text: &str, table: &str, rest: &str) -> Option<(usize, usize)> {
+    let (index, key) = rest.split_once(']')?;
+    let index: usize = index.parse().ok()?;
+    let key = key.trim_start_matches('.').split(['.', '[']).next().unwrap_or("");
+    let (mut seen, mut header, mut offset) = (0, None, 0);
+    for l in text.split_inclusive('\n') {
+        let t = l.trim();
+        let here = line_col(text, offset + (l.len() - l.trim_start().len()));
+        if t.starts_with('[') {
+            if header.is_some() {
+                break;
+            }
+            if t.starts_with("[[") && t.trim_matches(|c| c == '[' || c == ']').trim() == table {
+                seen += 1;
+                if seen == index + 1 {
+                    header = Some(here);
+                }
+            }
+        } else if header.is_some()
+            && !key.is_empty()
+            && t.split('=').next().map(str::trim) == Some(key)
+        {
+            return Some(here);
+        }
+        offset += l.len();
+    }
+    header
 }
 
 /// Sets `a.b.c=value` in a document; the value is parsed as TOML, or taken as a string.

@@ -1,39 +1,109 @@
-//! `[structure]`: which structure participant runs, and the settings of `structure-solver`
-//! (DESIGN §6).
+//! `[structure]`: which structure participant runs, and the model and analysis of
+//! `structure-solver` (DESIGN §6).
 //!
 //! Settings of `structure-solver` are optional here (a case may couple `rigid-structure`
-//! instead); `structure-solver` checks that what it needs is present when it runs.
+//! instead); `structure-solver` checks that what it needs is present when it runs, and the
+//! checks that need the mesh (set names, cell kinds of a part) happen there, naming the field.
 //!
 //! ```toml
 //! [structure]
-//! mesh = { generator = "rectangle", lx = 1.0, ly = 0.1, nx = 24, ny = 2 }   # or { gmsh = "plate.msh" }
-//! material = { e = 200e9, nu = 0.3, rho = 7800.0, sigma_y = 250e6, hardening = 1e9 }
-//! thickness = 0.01
-//! element = "bt4"                 # bt4 (explicit) | mitc4 (implicit)
-//! integrator = "central_difference"   # | newmark | midpoint
-//! dt = 1e-6                       # optional for central differences: safety x critical step
+//! # Mesh: one generator or a gmsh file (its physical groups become node and cell sets).
+//! #   rectangle  lx, ly, nx, ny                      [0,lx]x[0,ly] in z = 0
+//! #   cylinder   radius, length, n_theta, n_axial, theta_deg = [0, 360]   about z
+//! #   sphere     radius, n_theta, n_phi, theta_deg = [0, 360], phi_deg = [0, 90]
+//! #              (alias "hemisphere"; phi from +z; a pole becomes triangles)
+//! #   annulus    r_inner, r_outer, n_theta, n_r, theta_deg = [0, 360]  in z = 0
+//! #   line       from, to, n                         2-node beams
+//! #   gmsh       file                                relative to the case file
+//! # Grids have node sets u0, u1, v0, v1 (their edges; lines: start, end) and the cell set
+//! # all; `triangles = true` splits quadrilaterals; coincident nodes (seams) are merged.
+//! mesh = { generator = "rectangle", lx = 1.0, ly = 0.1, nx = 24, ny = 2 }
+//!
+//! # Analysis: central_difference (default) | newmark | midpoint | static.
+//! integrator = "central_difference"
+//! dt = 1e-6                         # central differences: default safety x critical step
 //! safety = 0.8
-//! t_end = 0.1
-//! output_every = 100              # steps between probe rows
-//! wet_set = "wet"                 # node set sent to the fluid when coupled
-//! [structure.sets]                # node sets by box (min and max corners), beside the mesh's
+//! t_end = 0.1                       # static: the final load factor (default 1)
+//! output_every = 100                # steps between probe rows
+//! # static only: steps (load increments, default 10), Newton settings and displacement
+//! # control of one dof (the loads then scale with the load factor λ):
+//! # steps = 10
+//! # newton = { tol = 1e-6, max_iter = 30, max_cuts = 8 }
+//! # control = { point = [1.0, 0.0, 0.0], dof = "uz", value = 0.5 }   # or set = "tip"
+//! # or arc-length path following (Crisfield) until the load factor reaches t_end, at most
+//! # `steps` steps; `initial` arc length (norm of a step's free-dof increment), its bounds
+//! # `min`/`max` (default initial/1000, 10 initial) and the Newton iterations it aims at:
+//! # arc_length = { initial = 0.1, min = 1e-4, max = 1.0, desired_iterations = 4 }
+//! wet_set = "wet"                   # node or cell set sent to the fluid when coupled
+//!
+//! # Materials by name: elastic, or J2 with linear isotropic hardening when sigma_y is given
+//! # (hardening = plastic modulus H, σ = σy + H εp). `material = {...}` is the one material
+//! # named "default".
+//! [structure.materials.steel]
+//! e = 200e9
+//! nu = 0.3
+//! rho = 7800.0
+//! sigma_y = 250e6
+//! hardening = 1e9
+//!
+//! # Parts: an element per cell set (a node set means the cells whose nodes all lie in it;
+//! # default every cell of the mesh's highest dimension: cells of a lower one in no part, as
+//! # the boundary lines of a gmsh surface, only define sets). Without parts, one part of
+//! # `element` (default bt4), `material` and `thickness` covers the mesh.
+//! #   bt4    explicit one-point shell, quadrilaterals (one material for all bt4 parts)
+//! #   mitc4  shell, quadrilaterals      dkt   shell, triangles
+//! #   shell  mitc4 or dkt by cell kind  beam  2-node beam      tet4  solid
+//! # J2 shells integrate `points` Gauss points through the thickness (default 5).
+//! [[structure.parts]]
+//! set = "all"
+//! element = "bt4"
+//! material = "steel"
+//! thickness = 0.01
+//! points = 5
+//! # beams: section = { rectangle = [b, h] } or { area, iy, iz, j }, and `up`, the local y axis
+//!
+//! # Node sets by box (min and max corners), beside the mesh's.
+//! [structure.sets]
 //! clamp = { min = [-1e-9, -1, -1], max = [1e-9, 1, 1] }
+//! tip = { min = [0.999999, -1, -1], max = [1.000001, 1, 1] }
+//!
+//! # Boundary conditions: one of fixed, symmetry, prescribed per entry.
 //! [[structure.bc]]
 //! set = "clamp"
-//! dofs = ["ux", "uy", "uz", "rx", "ry", "rz"]
-//! velocity = 0.0                  # prescribed velocity of those dofs (0 = fixed)
-//! [[structure.loads]]
+//! fixed = ["ux", "uy", "uz", "rx", "ry", "rz"]
+//! # symmetry = "y"                  # plane normal to y: uy = rx = rz = 0
+//! # prescribed = { dof = "uz", value = 0.01, curve = "linear" }   # value x curve(t)
+//!
+//! # Curves of time (the load factor in static runs): "constant", "linear" (= t),
+//! # { ramp = T } (0 to 1 over [0, T], then 1), { table = [[t, value], ...] } (linear between
+//! # points, constant outside). Default: "linear" in static runs, "constant" in dynamic ones.
+//! [[structure.loads]]               # point load per node of a node set (force or moment)
 //! set = "tip"
 //! dof = "uz"
-//! value = 10.0                    # force (moment) per node
+//! value = 10.0
+//! curve = { ramp = 1e-3 }
+//! # pressure = 1e5, set = "all"     # follower pressure on shell cells, along the normal of
+//! #                                 # the cells' node order
+//! # gravity = [0.0, 0.0, -9.81]     # acceleration on the lumped mass
+//!
 //! [[structure.initial_velocity]]
 //! set = "all"
 //! dof = "uz"
 //! value = 1.0
-//! [[structure.probes]]
-//! name = "tip"
-//! point = [1.0, 0.0, 0.0]         # the nearest node
+//!
+//! [[structure.probes]]              # displacement and velocity of the nearest node, to
+//! name = "tip"                      # structure_probes.csv (static: time = load factor)
+//! point = [1.0, 0.0, 0.0]
+//!
+//! # Rigid bodies: the nodes of `set` move with a new reference node (node set
+//! # "<set>_reference", where BCs and loads of the body go; loads on the set reach it too):
+//! # [[structure.rigid_bodies]]
+//! # set = "hub"
+//! # reference = [0.0, 0.0, 0.0]     # default: the mass centre of the set
+//! # mass = 1.0                      # mass added at the reference node
 //! ```
+
+use std::collections::BTreeMap;
 
 use super::RigidBody;
 use serde::Deserialize;
@@ -51,51 +121,126 @@ pub struct StructureSection {
     /// Mesh of `structure-solver`: a generator or a gmsh file.
     #[serde(default)]
     pub mesh: Option<StructureMesh>,
+    /// The material named `"default"`.
     #[serde(default)]
     pub material: Option<StructureMaterial>,
-    /// Shell thickness.
+    /// `[structure.materials.NAME]`.
+    #[serde(default)]
+    pub materials: BTreeMap<String, StructureMaterial>,
+    /// Shell thickness of the part made without `[[structure.parts]]`.
     #[serde(default)]
     pub thickness: Option<f64>,
-    /// `"bt4"` (default) or `"mitc4"`.
+    /// Element of the part made without `[[structure.parts]]`; default `bt4`.
     #[serde(default)]
-    pub element: Option<String>,
-    /// `"central_difference"` (default), `"newmark"` or `"midpoint"`.
+    pub element: Option<ElementType>,
     #[serde(default)]
-    pub integrator: Option<String>,
+    pub parts: Vec<StructurePart>,
+    /// Default `central_difference`.
+    #[serde(default)]
+    pub integrator: Option<Integrator>,
     /// Time step; central differences default to `safety` x the critical step.
     #[serde(default)]
     pub dt: Option<f64>,
     /// Fraction of the critical step; default 0.8.
     #[serde(default)]
     pub safety: Option<f64>,
-    /// End time of a run alone.
+    /// End time of a run alone (static: the final load factor, default 1).
     #[serde(default)]
     pub t_end: Option<f64>,
+    /// Static: load increments; default 10.
+    #[serde(default)]
+    pub steps: Option<usize>,
+    /// Static: Newton settings.
+    #[serde(default)]
+    pub newton: Option<NewtonSection>,
+    /// Static: displacement control.
+    #[serde(default)]
+    pub control: Option<ControlSection>,
+    /// Static: arc-length path following.
+    #[serde(default)]
+    pub arc_length: Option<ArcLengthSection>,
     /// Steps between probe rows; default 1.
     #[serde(default)]
     pub output_every: Option<u64>,
-    /// Node set of the wet surface.
+    /// Node or cell set of the wet surface.
     #[serde(default)]
     pub wet_set: Option<String>,
     /// Node sets by box.
     #[serde(default)]
-    pub sets: std::collections::BTreeMap<String, BoxSet>,
+    pub sets: BTreeMap<String, BoxSet>,
     #[serde(default)]
     pub bc: Vec<StructureBc>,
     #[serde(default)]
-    pub loads: Vec<NodalValue>,
+    pub loads: Vec<StructureLoad>,
     #[serde(default)]
     pub initial_velocity: Vec<NodalValue>,
     #[serde(default)]
     pub probes: Vec<StructureProbe>,
+    /// `[[structure.rigid_bodies]]`.
+    #[serde(default)]
+    pub rigid_bodies: Vec<RigidPart>,
 }
 
-/// `mesh = { generator = "rectangle", ... }` or `mesh = { gmsh = "file.msh" }`.
+/// `mesh = { generator = "...", ... }`; angles in degrees.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(untagged, deny_unknown_fields)]
+#[serde(tag = "generator", rename_all = "snake_case", deny_unknown_fields)]
 pub enum StructureMesh {
-    Rectangle { generator: String, lx: f64, ly: f64, nx: usize, ny: usize },
-    Gmsh { gmsh: String },
+    Rectangle {
+        lx: f64,
+        ly: f64,
+        nx: usize,
+        ny: usize,
+        #[serde(default)]
+        triangles: bool,
+    },
+    Cylinder {
+        radius: f64,
+        length: f64,
+        n_theta: usize,
+        n_axial: usize,
+        #[serde(default = "full_turn")]
+        theta_deg: [f64; 2],
+        #[serde(default)]
+        triangles: bool,
+    },
+    #[serde(alias = "hemisphere")]
+    Sphere {
+        radius: f64,
+        n_theta: usize,
+        n_phi: usize,
+        #[serde(default = "full_turn")]
+        theta_deg: [f64; 2],
+        #[serde(default = "upper_half")]
+        phi_deg: [f64; 2],
+        #[serde(default)]
+        triangles: bool,
+    },
+    Annulus {
+        r_inner: f64,
+        r_outer: f64,
+        n_theta: usize,
+        n_r: usize,
+        #[serde(default = "full_turn")]
+        theta_deg: [f64; 2],
+        #[serde(default)]
+        triangles: bool,
+    },
+    Line {
+        from: [f64; 3],
+        to: [f64; 3],
+        n: usize,
+    },
+    Gmsh {
+        file: String,
+    },
+}
+
+fn full_turn() -> [f64; 2] {
+    [0.0, 360.0]
+}
+
+fn upper_half() -> [f64; 2] {
+    [0.0, 90.0]
 }
 
 /// Linear elastic, or J2 with linear isotropic hardening when `sigma_y` is given; `hardening`
@@ -112,6 +257,135 @@ pub struct StructureMaterial {
     pub hardening: f64,
 }
 
+/// Element families of a part.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ElementType {
+    /// Explicit one-point Belytschko-Tsay shell on quadrilaterals.
+    Bt4,
+    /// MITC4 shell on quadrilaterals.
+    Mitc4,
+    /// DKT shell on triangles.
+    Dkt,
+    /// MITC4 on quadrilaterals, DKT on triangles.
+    Shell,
+    Beam,
+    Tet4,
+}
+
+/// `[[structure.parts]]`: what the cells of a set become.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StructurePart {
+    /// Cell set, or node set (the cells whose nodes all lie in it); default every cell of the
+    /// mesh's highest dimension.
+    #[serde(default)]
+    pub set: Option<String>,
+    pub element: ElementType,
+    /// Name in `materials` (`"default"` is `material`); default the only material.
+    #[serde(default)]
+    pub material: Option<String>,
+    /// Shell thickness.
+    #[serde(default)]
+    pub thickness: Option<f64>,
+    /// Gauss points through the thickness of J2 shells; default 5.
+    #[serde(default)]
+    pub points: Option<usize>,
+    /// Beam cross-section.
+    #[serde(default)]
+    pub section: Option<BeamSectionSpec>,
+    /// Beams: the local `y` axis (projected normal to the beam).
+    #[serde(default)]
+    pub up: Option<[f64; 3]>,
+}
+
+/// `section = { rectangle = [b, h] }` (b along the local y axis) or `{ area, iy, iz, j }`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeamSectionSpec {
+    #[serde(default)]
+    pub rectangle: Option<[f64; 2]>,
+    #[serde(default)]
+    pub area: Option<f64>,
+    #[serde(default)]
+    pub iy: Option<f64>,
+    #[serde(default)]
+    pub iz: Option<f64>,
+    #[serde(default)]
+    pub j: Option<f64>,
+}
+
+/// Time integration or statics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integrator {
+    CentralDifference,
+    Newmark,
+    Midpoint,
+    Static,
+}
+
+impl Integrator {
+    /// The name in case files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::CentralDifference => "central_difference",
+            Integrator::Newmark => "newmark",
+            Integrator::Midpoint => "midpoint",
+            Integrator::Static => "static",
+        }
+    }
+}
+
+/// `newton = { tol, max_iter, max_cuts }` of static runs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSection {
+    #[serde(default)]
+    pub tol: Option<f64>,
+    #[serde(default)]
+    pub max_iter: Option<usize>,
+    #[serde(default)]
+    pub max_cuts: Option<usize>,
+}
+
+/// `control = { point | set, dof, value }`: the dof driven to `value` in `steps` increments.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlSection {
+    #[serde(default)]
+    pub point: Option<[f64; 3]>,
+    #[serde(default)]
+    pub set: Option<String>,
+    pub dof: Dof,
+    pub value: f64,
+}
+
+/// `arc_length = { initial, min, max, desired_iterations }`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArcLengthSection {
+    pub initial: f64,
+    #[serde(default)]
+    pub min: Option<f64>,
+    #[serde(default)]
+    pub max: Option<f64>,
+    #[serde(default)]
+    pub desired_iterations: Option<usize>,
+}
+
+impl ArcLengthSection {
+    /// Smallest arc length; default `initial / 1000`.
+    pub fn min(&self) -> f64 {
+        self.min.unwrap_or(1e-3 * self.initial)
+    }
+
+    /// Largest arc length; default `10 initial`.
+    pub fn max(&self) -> f64 {
+        self.max.unwrap_or(10.0 * self.initial)
+    }
+}
+
 /// Nodes inside an axis-aligned box.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -120,14 +394,160 @@ pub struct BoxSet {
     pub max: [f64; 3],
 }
 
-/// Dofs of a set fixed or moving at a constant velocity.
+/// The six nodal dofs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Dof {
+    Ux,
+    Uy,
+    Uz,
+    Rx,
+    Ry,
+    Rz,
+}
+
+impl Dof {
+    /// Index in `[ux, uy, uz, rx, ry, rz]`.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// A global axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// A scalar function of time (the load factor in static runs).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a curve: \"constant\", \"linear\", { ramp = T } or { table = [[t, value], ...] }"
+)]
+pub enum CurveSpec {
+    Named(CurveName),
+    Ramp(RampCurve),
+    Table(TableCurve),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveName {
+    Constant,
+    Linear,
+}
+
+/// 0 at `t = 0` to 1 at `t = ramp`, then 1.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RampCurve {
+    pub ramp: f64,
+}
+
+/// Piecewise linear through `(t, value)` points, constant outside.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableCurve {
+    pub table: Vec<[f64; 2]>,
+}
+
+impl CurveSpec {
+    fn validate(&self, field: &str) -> Result<(), (String, String)> {
+        match self {
+            CurveSpec::Named(_) => Ok(()),
+            CurveSpec::Ramp(r) => super::require_positive(&format!("{field}.ramp"), r.ramp),
+            CurveSpec::Table(t) => {
+                let ok = !t.table.is_empty()
+                    && t.table.iter().flatten().all(|v| v.is_finite())
+                    && t.table.windows(2).all(|w| w[1][0] > w[0][0]);
+                if ok {
+                    Ok(())
+                } else {
+                    Err((
+                        format!("{field}.table"),
+                        "expected at least one finite [t, value] point, t strictly increasing"
+                            .into(),
+                    ))
+                }
+            }
+        }
+    }
+}
+
+/// `[[structure.bc]]`: one of `fixed`, `symmetry`, `prescribed` on the nodes of `set`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StructureBc {
     pub set: String,
-    pub dofs: Vec<String>,
+    /// Dofs held at zero.
     #[serde(default)]
-    pub velocity: f64,
+    pub fixed: Vec<Dof>,
+    /// Symmetry about the plane normal to this axis.
+    #[serde(default)]
+    pub symmetry: Option<Axis>,
+    #[serde(default)]
+    pub prescribed: Option<Prescribed>,
+}
+
+/// `prescribed = { dof, value, curve }`: the dof's displacement (rotation) is `value · curve(t)`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Prescribed {
+    pub dof: Dof,
+    pub value: f64,
+    #[serde(default)]
+    pub curve: Option<CurveSpec>,
+}
+
+/// `[[structure.loads]]`: a point load (`set`, `dof`, `value`: per node), a follower
+/// `pressure` on the shell cells of `set` (default all), or `gravity`; each times `curve`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StructureLoad {
+    #[serde(default)]
+    pub set: Option<String>,
+    #[serde(default)]
+    pub dof: Option<Dof>,
+    #[serde(default)]
+    pub value: Option<f64>,
+    #[serde(default)]
+    pub pressure: Option<f64>,
+    #[serde(default)]
+    pub gravity: Option<[f64; 3]>,
+    #[serde(default)]
+    pub curve: Option<CurveSpec>,
+}
+
+/// What a `[[structure.loads]]` entry is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LoadKind<'a> {
+    Point { set: &'a str, dof: Dof, value: f64 },
+    Pressure { set: Option<&'a str>, p: f64 },
+    Gravity([f64; 3]),
+}
+
+impl StructureLoad {
+    /// The load this entry describes (after validation).
+    pub fn kind(&self) -> Option<LoadKind<'_>> {
+        match (self.value, self.pressure, self.gravity) {
+            (Some(value), None, None) => {
+                Some(LoadKind::Point { set: self.set.as_deref()?, dof: self.dof?, value })
+            }
+            (None, Some(p), None) => Some(LoadKind::Pressure { set: self.set.as_deref(), p }),
+            (None, None, Some(g)) => Some(LoadKind::Gravity(g)),
+            _ => None,
+        }
+    }
 }
 
 /// A value on one dof of every node of a set.
@@ -135,7 +555,7 @@ pub struct StructureBc {
 #[serde(deny_unknown_fields)]
 pub struct NodalValue {
     pub set: String,
-    pub dof: String,
+    pub dof: Dof,
     pub value: f64,
 }
 
@@ -147,12 +567,117 @@ pub struct StructureProbe {
     pub point: [f64; 3],
 }
 
-/// Names of the six nodal dofs, in order.
-pub const STRUCTURE_DOFS: [&str; 6] = ["ux", "uy", "uz", "rx", "ry", "rz"];
+/// `[[structure.rigid_bodies]]`: the nodes of `set` move as one rigid body with a new
+/// reference node at `reference` (default their mass centre), which carries `mass` more.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidPart {
+    pub set: String,
+    #[serde(default)]
+    pub reference: Option<[f64; 3]>,
+    #[serde(default)]
+    pub mass: f64,
+}
 
-/// Index of a dof name.
-pub fn structure_dof(name: &str) -> Option<usize> {
-    STRUCTURE_DOFS.iter().position(|d| *d == name)
+fn finite(field: &str, v: &[f64]) -> Result<(), (String, String)> {
+    match v.iter().find(|x| !x.is_finite()) {
+        Some(x) => Err((field.to_string(), format!("expected finite numbers, got {x}"))),
+        None => Ok(()),
+    }
+}
+
+fn at_least_one(field: &str, n: usize, what: &str) -> Result<(), (String, String)> {
+    if n == 0 {
+        Err((field.to_string(), format!("expected at least one {what}")))
+    } else {
+        Ok(())
+    }
+}
+
+fn angles(field: &str, a: [f64; 2], lo: f64, hi: f64) -> Result<(), (String, String)> {
+    if a.iter().all(|v| v.is_finite() && *v >= lo && *v <= hi) && a[1] > a[0] {
+        Ok(())
+    } else {
+        Err((field.to_string(), format!("expected {lo} <= start < end <= {hi}, got {a:?}")))
+    }
+}
+
+impl StructureMesh {
+    fn validate(&self) -> Result<(), (String, String)> {
+        use super::require_positive as pos;
+        let f = |k: &str| format!("structure.mesh.{k}");
+        match self {
+            StructureMesh::Rectangle { lx, ly, nx, ny, .. } => {
+                pos(&f("lx"), *lx)?;
+                pos(&f("ly"), *ly)?;
+                at_least_one(&f("nx"), *nx, "cell")?;
+                at_least_one(&f("ny"), *ny, "cell")
+            }
+            StructureMesh::Cylinder { radius, length, n_theta, n_axial, theta_deg, .. } => {
+                pos(&f("radius"), *radius)?;
+                pos(&f("length"), *length)?;
+                at_least_one(&f("n_theta"), *n_theta, "cell")?;
+                at_least_one(&f("n_axial"), *n_axial, "cell")?;
+                angles(&f("theta_deg"), *theta_deg, -360.0, 360.0)
+            }
+            StructureMesh::Sphere { radius, n_theta, n_phi, theta_deg, phi_deg, .. } => {
+                pos(&f("radius"), *radius)?;
+                at_least_one(&f("n_theta"), *n_theta, "cell")?;
+                at_least_one(&f("n_phi"), *n_phi, "cell")?;
+                angles(&f("theta_deg"), *theta_deg, -360.0, 360.0)?;
+                angles(&f("phi_deg"), *phi_deg, 0.0, 180.0)
+            }
+            StructureMesh::Annulus { r_inner, r_outer, n_theta, n_r, theta_deg, .. } => {
+                if !(r_inner.is_finite() && *r_inner >= 0.0 && r_outer > r_inner) {
+                    return Err((
+                        f("r_outer"),
+                        format!("expected 0 <= r_inner < r_outer, got {r_inner} and {r_outer}"),
+                    ));
+                }
+                at_least_one(&f("n_theta"), *n_theta, "cell")?;
+                at_least_one(&f("n_r"), *n_r, "cell")?;
+                angles(&f("theta_deg"), *theta_deg, -360.0, 360.0)
+            }
+            StructureMesh::Line { from, to, n } => {
+                finite(&f("from"), from)?;
+                finite(&f("to"), to)?;
+                if from == to {
+                    return Err((f("to"), "expected a point other than `from`".into()));
+                }
+                at_least_one(&f("n"), *n, "cell")
+            }
+            StructureMesh::Gmsh { file } => {
+                if file.is_empty() {
+                    return Err((f("file"), "expected a gmsh file name".into()));
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl StructureMaterial {
+    fn validate(&self, field: &str) -> Result<(), (String, String)> {
+        use super::require_positive;
+        require_positive(&format!("{field}.e"), self.e)?;
+        require_positive(&format!("{field}.rho"), self.rho)?;
+        if !(self.nu > -1.0 && self.nu < 0.5) {
+            return Err((
+                format!("{field}.nu"),
+                format!("expected -1 < nu < 0.5, got {}", self.nu),
+            ));
+        }
+        if let Some(sy) = self.sigma_y {
+            require_positive(&format!("{field}.sigma_y"), sy)?;
+        }
+        if !(self.hardening >= 0.0 && self.hardening.is_finite()) {
+            return Err((
+                format!("{field}.hardening"),
+                format!("expected a finite number >= 0, got {}", self.hardening),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl StructureSection {
@@ -161,45 +686,39 @@ impl StructureSection {
         self.command.clone().unwrap_or_else(|| vec!["structure-solver".to_string()])
     }
 
+    /// The materials by name, `material` as `"default"`.
+    pub fn all_materials(&self) -> BTreeMap<String, StructureMaterial> {
+        let mut m = self.materials.clone();
+        if let Some(d) = self.material {
+            m.insert("default".into(), d);
+        }
+        m
+    }
+
+    /// The integrator; default central differences.
+    pub fn integrator(&self) -> Integrator {
+        self.integrator.unwrap_or(Integrator::CentralDifference)
+    }
+
     pub(crate) fn validate(&self) -> Result<(), (String, String)> {
         use super::require_positive;
         if let Some(r) = &self.rigid {
             r.validate()?;
         }
-        if let Some(StructureMesh::Rectangle { generator, lx, ly, nx, ny }) = &self.mesh {
-            if generator != "rectangle" {
-                return Err((
-                    "structure.mesh.generator".into(),
-                    format!("expected \"rectangle\", got \"{generator}\""),
-                ));
-            }
-            require_positive("structure.mesh.lx", *lx)?;
-            require_positive("structure.mesh.ly", *ly)?;
-            if *nx == 0 || *ny == 0 {
-                return Err((
-                    "structure.mesh.nx".into(),
-                    "expected at least one element each way".into(),
-                ));
-            }
+        if let Some(m) = &self.mesh {
+            m.validate()?;
         }
         if let Some(m) = &self.material {
-            require_positive("structure.material.e", m.e)?;
-            require_positive("structure.material.rho", m.rho)?;
-            if !(m.nu > -1.0 && m.nu < 0.5) {
+            if self.materials.contains_key("default") {
                 return Err((
-                    "structure.material.nu".into(),
-                    format!("expected -1 < nu < 0.5, got {}", m.nu),
+                    "structure.materials.default".into(),
+                    "`material` is the material named \"default\"; give one or the other".into(),
                 ));
             }
-            if let Some(sy) = m.sigma_y {
-                require_positive("structure.material.sigma_y", sy)?;
-            }
-            if !(m.hardening >= 0.0 && m.hardening.is_finite()) {
-                return Err((
-                    "structure.material.hardening".into(),
-                    format!("expected a finite number >= 0, got {}", m.hardening),
-                ));
-            }
+            m.validate("structure.material")?;
+        }
+        for (name, m) in &self.materials {
+            m.validate(&format!("structure.materials.{name}"))?;
         }
         for (field, v) in [
             ("structure.thickness", self.thickness),
@@ -218,39 +737,251 @@ impl StructureSection {
                 ));
             }
         }
-        if let Some(e) = &self.element {
-            if e != "bt4" && e != "mitc4" {
+        self.validate_parts()?;
+        self.validate_analysis()?;
+        for (name, b) in &self.sets {
+            finite(&format!("structure.sets.{name}"), &[b.min, b.max].concat())?;
+        }
+        for (k, b) in self.bc.iter().enumerate() {
+            let f = format!("structure.bc[{k}]");
+            let given = [!b.fixed.is_empty(), b.symmetry.is_some(), b.prescribed.is_some()];
+            if given.iter().filter(|g| **g).count() != 1 {
                 return Err((
-                    "structure.element".into(),
-                    format!("expected \"bt4\" or \"mitc4\", got \"{e}\""),
+                    f,
+                    "expected exactly one of `fixed = [dofs]`, `symmetry = \"x|y|z\"`, \
+                     `prescribed = { dof, value, curve }`"
+                        .into(),
+                ));
+            }
+            if let Some(p) = &b.prescribed {
+                finite(&format!("{f}.prescribed.value"), &[p.value])?;
+                if let Some(c) = &p.curve {
+                    c.validate(&format!("{f}.prescribed.curve"))?;
+                }
+            }
+        }
+        let mut gravity = 0;
+        for (k, l) in self.loads.iter().enumerate() {
+            let f = format!("structure.loads[{k}]");
+            let Some(kind) = l.kind() else {
+                return Err((
+                    f,
+                    "expected a point load (`set`, `dof`, `value`), a `pressure` (with an \
+                     optional `set`) or a `gravity` vector"
+                        .into(),
+                ));
+            };
+            match kind {
+                LoadKind::Point { value, .. } => finite(&format!("{f}.value"), &[value])?,
+                LoadKind::Pressure { p, .. } => {
+                    if l.dof.is_some() {
+                        return Err((
+                            format!("{f}.dof"),
+                            "a pressure acts along the normal; remove `dof`".into(),
+                        ));
+                    }
+                    finite(&format!("{f}.pressure"), &[p])?
+                }
+                LoadKind::Gravity(g) => {
+                    if l.set.is_some() || l.dof.is_some() {
+                        return Err((
+                            format!("{f}.gravity"),
+                            "gravity acts on every node; remove `set` and `dof`".into(),
+                        ));
+                    }
+                    gravity += 1;
+                    if gravity > 1 {
+                        return Err((format!("{f}.gravity"), "expected one gravity load".into()));
+                    }
+                    finite(&format!("{f}.gravity"), &g)?
+                }
+            }
+            if let Some(c) = &l.curve {
+                c.validate(&format!("{f}.curve"))?;
+            }
+        }
+        for (k, r) in self.rigid_bodies.iter().enumerate() {
+            let f = format!("structure.rigid_bodies[{k}]");
+            if let Some(p) = r.reference {
+                finite(&format!("{f}.reference"), &p)?;
+            }
+            if !(r.mass >= 0.0 && r.mass.is_finite()) {
+                return Err((
+                    format!("{f}.mass"),
+                    format!("expected a finite mass >= 0, got {}", r.mass),
                 ));
             }
         }
-        if let Some(i) = &self.integrator {
-            if !["central_difference", "newmark", "midpoint"].contains(&i.as_str()) {
+        Ok(())
+    }
+
+    /// Parts: known materials, a thickness on shells, a section on beams.
+    fn validate_parts(&self) -> Result<(), (String, String)> {
+        let materials = self.all_materials();
+        let known = || materials.keys().cloned().collect::<Vec<_>>().join(", ");
+        if !self.parts.is_empty() {
+            for (field, given) in [
+                ("structure.element", self.element.is_some()),
+                ("structure.thickness", self.thickness.is_some()),
+            ] {
+                if given {
+                    return Err((
+                        field.into(),
+                        "give the element and thickness in each [[structure.parts]] entry when \
+                         there are parts"
+                            .into(),
+                    ));
+                }
+            }
+        }
+        for (k, p) in self.parts.iter().enumerate() {
+            let f = format!("structure.parts[{k}]");
+            match &p.material {
+                Some(m) if !materials.contains_key(m) => {
+                    return Err((
+                        format!("{f}.material"),
+                        format!("no material \"{m}\"; known materials: {}", known()),
+                    ))
+                }
+                None if materials.len() != 1 => {
+                    return Err((
+                        format!("{f}.material"),
+                        format!("expected the name of one of the materials: {}", known()),
+                    ))
+                }
+                _ => {}
+            }
+            let shell = matches!(
+                p.element,
+                ElementType::Bt4 | ElementType::Mitc4 | ElementType::Dkt | ElementType::Shell
+            );
+            match (shell, p.thickness) {
+                (true, None) => {
+                    return Err((format!("{f}.thickness"), "expected the shell thickness".into()))
+                }
+                (true, Some(h)) => super::require_positive(&format!("{f}.thickness"), h)?,
+                (false, Some(_)) => {
+                    return Err((format!("{f}.thickness"), "only shells have a thickness".into()))
+                }
+                (false, None) => {}
+            }
+            if let Some(n) = p.points {
+                if !shell || !(1..=10).contains(&n) {
+                    return Err((
+                        format!("{f}.points"),
+                        "expected 1 to 10 Gauss points through a shell's thickness".into(),
+                    ));
+                }
+            }
+            match (p.element == ElementType::Beam, &p.section, p.up) {
+                (true, Some(s), Some(up)) => {
+                    let full = [s.area, s.iy, s.iz, s.j];
+                    let ok = match (s.rectangle, full.iter().all(Option::is_some)) {
+                        (Some(r), false) if full.iter().all(Option::is_none) => {
+                            r.iter().all(|v| v.is_finite() && *v > 0.0)
+                        }
+                        (None, true) => full.iter().flatten().all(|v| v.is_finite() && *v > 0.0),
+                        _ => false,
+                    };
+                    if !ok {
+                        return Err((
+                            format!("{f}.section"),
+                            "expected { rectangle = [b, h] } or { area, iy, iz, j }, all > 0"
+                                .into(),
+                        ));
+                    }
+                    finite(&format!("{f}.up"), &up)?;
+                    if up == [0.0; 3] {
+                        return Err((format!("{f}.up"), "expected a nonzero vector".into()));
+                    }
+                }
+                (true, None, _) => {
+                    return Err((format!("{f}.section"), "a beam needs a section".into()))
+                }
+                (true, _, None) => {
+                    return Err((format!("{f}.up"), "a beam needs an `up` vector".into()))
+                }
+                (false, Some(_), _) => {
+                    return Err((format!("{f}.section"), "only beams have a section".into()))
+                }
+                (false, _, Some(_)) => {
+                    return Err((format!("{f}.up"), "only beams have an `up` vector".into()))
+                }
+                (false, None, None) => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// Static settings only with `integrator = "static"`.
+    fn validate_analysis(&self) -> Result<(), (String, String)> {
+        let statics = self.integrator() == Integrator::Static;
+        for (field, given) in [
+            ("structure.steps", self.steps.is_some()),
+            ("structure.newton", self.newton.is_some()),
+            ("structure.control", self.control.is_some()),
+            ("structure.arc_length", self.arc_length.is_some()),
+        ] {
+            if given && !statics {
+                return Err((field.into(), "applies to integrator = \"static\" only".into()));
+            }
+        }
+        if statics && self.dt.is_some() {
+            return Err((
+                "structure.dt".into(),
+                "a static run steps the load factor; give `steps` instead".into(),
+            ));
+        }
+        if self.steps == Some(0) {
+            return Err(("structure.steps".into(), "expected at least one load step".into()));
+        }
+        if let Some(n) = &self.newton {
+            if let Some(t) = n.tol {
+                super::require_positive("structure.newton.tol", t)?;
+            }
+            if n.max_iter == Some(0) {
+                return Err(("structure.newton.max_iter".into(), "expected at least 1".into()));
+            }
+        }
+        if let Some(a) = &self.arc_length {
+            if self.control.is_some() {
                 return Err((
-                    "structure.integrator".into(),
+                    "structure.arc_length".into(),
+                    "give one of `control` and `arc_length`".into(),
+                ));
+            }
+            super::require_positive("structure.arc_length.initial", a.initial)?;
+            if !(a.min() > 0.0 && a.min() <= a.initial && a.initial <= a.max()) {
+                return Err((
+                    "structure.arc_length".into(),
                     format!(
-                        "expected \"central_difference\", \"newmark\" or \"midpoint\", got \"{i}\""
+                        "expected 0 < min <= initial <= max, got {} <= {} <= {}",
+                        a.min(),
+                        a.initial,
+                        a.max()
                     ),
                 ));
             }
-        }
-        let dof_ok = |field: &str, d: &str| {
-            structure_dof(d).map(|_| ()).ok_or_else(|| {
-                (field.to_string(), format!("expected one of {STRUCTURE_DOFS:?}, got \"{d}\""))
-            })
-        };
-        for b in &self.bc {
-            for d in &b.dofs {
-                dof_ok("structure.bc.dofs", d)?;
+            if a.desired_iterations == Some(0) {
+                return Err((
+                    "structure.arc_length.desired_iterations".into(),
+                    "expected at least 1".into(),
+                ));
             }
         }
-        for l in &self.loads {
-            dof_ok("structure.loads.dof", &l.dof)?;
-        }
-        for l in &self.initial_velocity {
-            dof_ok("structure.initial_velocity.dof", &l.dof)?;
+        if let Some(c) = &self.control {
+            if c.point.is_some() == c.set.is_some() {
+                return Err((
+                    "structure.control".into(),
+                    "expected one of `point = [x, y, z]` or `set` (a set of one node)".into(),
+                ));
+            }
+            if !(c.value.is_finite() && c.value != 0.0) {
+                return Err((
+                    "structure.control.value".into(),
+                    format!("expected a finite nonzero displacement, got {}", c.value),
+                ));
+            }
         }
         Ok(())
     }

@@ -10,7 +10,7 @@
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
-use super::rotation::{log, spin, tangent_inverse};
+use super::rotation::{exp, log, spin, tangent_inverse, tangent_inverse_transpose_derivative};
 
 /// How an element's corotated frame follows its nodes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -214,6 +214,103 @@ impl Reference {
             f[6 * j..6 * j + 3].copy_from_slice(fx.as_slice());
             f[6 * j + 3..6 * j + 6].copy_from_slice(fw.as_slice());
         }
+    }
+}
+
+/// Relative step of the central differences of the frame's spin matrices.
+const FRAME_STEP: f64 = 1e-5;
+
+impl Reference {
+    /// Consistent tangent `∂(Bᵀ f_l)/∂q = Bᵀ K_l B + K_G` of a corotated element at `x`, `r`
+    /// with local forces `f_l` and local tangent `K_l` at the deformation `d` (from
+    /// `deformation`, with `b` = `B` and `fr` its frame). `K_G`, the variation of `Bᵀ` at fixed
+    /// `f_l` (Felippa & Haugen 2005, §6: the `K_GR`, `K_GP` and `K_GM` parts), is in closed
+    /// form from `δE = E[ω̄]×`, `δbᵢ = B_uᵢ δq`, `δθᵢ = B_θᵢ δq` and `∂(T⁻ᵀ f)/∂θ`, except the
+    /// variation of the frame's spin matrices `gx`, `gr` contracted with the moment vector `m`
+    /// of `force`, which is by central differences of the frame alone (cross products only;
+    /// translations, and for beams rotations, `FRAME_STEP` relative).
+    #[allow(clippy::too_many_arguments)]
+    pub fn tangent(
+        &self,
+        x: &[Vector3<f64>],
+        r: &[Matrix3<f64>],
+        d: &[f64],
+        b: &DMatrix<f64>,
+        fr: &Frame,
+        fl: &[f64],
+        kl: &DMatrix<f64>,
+    ) -> DMatrix<f64> {
+        let n = x.len();
+        let size = 6 * n;
+        let mut kt = b.transpose() * (kl * b);
+        let e = fr.e;
+        let et = e.transpose();
+        let v3 = |s: &[f64], o: usize| Vector3::new(s[o], s[o + 1], s[o + 2]);
+        let mut g = DMatrix::zeros(3, size);
+        for j in 0..n {
+            g.fixed_view_mut::<3, 3>(0, 6 * j).copy_from(&fr.gx[j]);
+            g.fixed_view_mut::<3, 3>(0, 6 * j + 3).copy_from(&fr.gr[j]);
+        }
+        let mean = (0..n).map(|i| v3(fl, 6 * i)).sum::<Vector3<f64>>() / n as f64;
+        // m = Σ [bᵢ]×ᵀ f_uᵢ - tᵢ and its variation Δm = Σ [f_uᵢ]× Δbᵢ - Mθᵢ Δθᵢ
+        let mut m = Vector3::zeros();
+        let mut dm = DMatrix::zeros(3, size);
+        let mut t = [Vector3::zeros(); 4];
+        let mut mth = [Matrix3::zeros(); 4];
+        for i in 0..n {
+            let (fu, ft, th) = (v3(fl, 6 * i), v3(fl, 6 * i + 3), v3(d, 6 * i + 3));
+            let bi = et * (x[i] - fr.xc);
+            t[i] = tangent_inverse(&th).transpose() * ft;
+            mth[i] = tangent_inverse_transpose_derivative(&th, &ft);
+            m += spin(&bi).transpose() * fu - t[i];
+            dm += spin(&fu) * b.rows(6 * i, 3) - mth[i] * b.rows(6 * i + 3, 3);
+        }
+        for j in 0..n {
+            let fu = v3(fl, 6 * j);
+            let rows_x = -(e * spin(&(fu - mean))) * &g + fr.gx[j].transpose() * &dm;
+            let rows_w = -(e * spin(&t[j])) * &g
+                + (e * mth[j]) * b.rows(6 * j + 3, 3)
+                + fr.gr[j].transpose() * &dm;
+            let mut rx = kt.rows_mut(6 * j, 3);
+            rx += &rows_x;
+            let mut rw = kt.rows_mut(6 * j + 3, 3);
+            rw += &rows_w;
+        }
+        // Δgxⱼᵀ m, Δgrⱼᵀ m: central differences of the frame
+        let scale = (1..n).map(|i| (x[i] - x[0]).norm()).fold(0.0, f64::max);
+        let rotations = matches!(self.rule, FrameRule::Beam { .. });
+        let spin_terms = |f: &Frame, out: &mut [f64]| {
+            for j in 0..n {
+                out[6 * j..6 * j + 3].copy_from_slice((f.gx[j].transpose() * m).as_slice());
+                out[6 * j + 3..6 * j + 6].copy_from_slice((f.gr[j].transpose() * m).as_slice());
+            }
+        };
+        let (mut xp, mut rp) = (x.to_vec(), r.to_vec());
+        let (mut hp, mut hm) = ([0.0; 24], [0.0; 24]);
+        for k in 0..n {
+            for c in 0..6 {
+                if c >= 3 && !rotations {
+                    continue;
+                }
+                let h = if c < 3 { FRAME_STEP * scale } else { FRAME_STEP };
+                for (sign, out) in [(1.0, &mut hp), (-1.0, &mut hm)] {
+                    if c < 3 {
+                        xp[k][c] = x[k][c] + sign * h;
+                    } else {
+                        let mut w = Vector3::zeros();
+                        w[c - 3] = sign * h;
+                        rp[k] = exp(&w) * r[k];
+                    }
+                    spin_terms(&frame(self.rule, &xp, &rp), &mut out[..size]);
+                    xp[k] = x[k];
+                    rp[k] = r[k];
+                }
+                for i in 0..size {
+                    kt[(i, 6 * k + c)] += (hp[i] - hm[i]) / (2.0 * h);
+                }
+            }
+        }
+        kt
     }
 }
 

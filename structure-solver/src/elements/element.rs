@@ -1,8 +1,11 @@
 //! The element container: corotated shells (elastic, or J2 through the thickness: `layered`)
 //! and beams, total-Lagrangian tets, each with its internal force from a flat per-element
-//! material state, a consistent tangent by central differences of that force (translations
-//! perturbed additively, rotations by spatial spins, exactly as `Model::apply_increment`
-//! composes them) and a lumped mass.
+//! material state, a consistent tangent (corotated elements: `Bᵀ K_l B` plus the geometric
+//! stiffness of `corotation::Reference::tangent`, with the algorithmic tangent of J2 sections;
+//! tets: central differences of the force, translations perturbed additively, rotations by
+//! spatial spins, exactly as `Model::apply_increment` composes them; the central differences
+//! of every element are kept as `tangent_by_differences`, the check of the others) and a
+//! lumped mass.
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
@@ -204,7 +207,7 @@ impl Element {
                 reference.force(x, r, &mut d[..nd], local, f);
             }
             Body::Layered { reference, shell } => {
-                let local = |d: &[f64], fl: &mut [f64]| shell.force(d, old, new, fl);
+                let local = |d: &[f64], fl: &mut [f64]| shell.force(d, old, new, fl, None);
                 reference.force(x, r, &mut d[..nd], local, f);
             }
             Body::Tet(t) => {
@@ -234,11 +237,10 @@ impl Element {
     }
 
     /// Tangent `∂f/∂q` (with `extra`, a configuration-dependent load term `-f_ext`
-    /// differentiated with it). Elastic corotated elements: the material part `Bᵀ K B` exactly
-    /// (`B = ∂d/∂q` of `corotation`) plus the geometric part `∂(Bᵀ)/∂q f_l` (and the load term)
-    /// by forward differences at fixed local forces `f_l`. Other elements: central differences
-    /// of `force` (forward differences of the whole force proved too inaccurate for thin shells
-    /// in large rotation). Steps: `FD_STEP` relative.
+    /// differentiated with it). Corotated shells and beams: the consistent tangent
+    /// `Bᵀ K_l B + K_G` of `Reference::tangent`, `K_l` the elastic stiffness or the algorithmic
+    /// tangent of the J2 sections; tets: central differences of `force`
+    /// (`tangent_by_differences`). The load term (positions only) by central differences.
     pub fn tangent(
         &self,
         x: &[Vector3<f64>],
@@ -246,11 +248,68 @@ impl Element {
         state: &[f64],
         extra: Option<&LoadFn>,
     ) -> DMatrix<f64> {
-        let n = x.len();
-        let size = 6 * n;
-        let mut tmp = vec![0.0; size];
+        let size = 6 * x.len();
+        let (reference, fl, kl, d, b, fr) = match &self.body {
+            Body::Tet(_) => return self.tangent_by_differences(x, r, state, extra),
+            Body::Corotated { reference, k } => {
+                let mut d = vec![0.0; size];
+                let mut b = DMatrix::zeros(size, size);
+                let fr = reference.deformation(x, r, &mut d, Some(&mut b));
+                let fl = k * nalgebra::DVector::from_column_slice(&d);
+                (reference, fl.as_slice().to_vec(), std::borrow::Cow::Borrowed(k), d, b, fr)
+            }
+            Body::Layered { reference, shell } => {
+                let mut d = vec![0.0; size];
+                let mut b = DMatrix::zeros(size, size);
+                let fr = reference.deformation(x, r, &mut d, Some(&mut b));
+                let mut fl = vec![0.0; size];
+                let mut kl = DMatrix::zeros(size, size);
+                let mut trial = vec![0.0; state.len()];
+                shell.force(&d, state, &mut trial, &mut fl, Some(&mut kl));
+                (reference, fl, std::borrow::Cow::Owned(kl), d, b, fr)
+            }
+        };
+        let mut kt = reference.tangent(x, r, &d, &b, &fr, &fl, &kl);
+        if let Some(load) = extra {
+            Self::add_load_tangent(x, load, &mut kt);
+        }
+        kt
+    }
+
+    /// Adds `-∂f_ext/∂x` of a load of the positions by central differences.
+    fn add_load_tangent(x: &[Vector3<f64>], load: &LoadFn, kt: &mut DMatrix<f64>) {
+        let size = 6 * x.len();
+        let (mut fp, mut fm) = (vec![0.0; size], vec![0.0; size]);
+        let r = vec![Matrix3::identity(); x.len()];
+        Self::perturb(x, &r, false, |xs, _, col, h| {
+            if h > 0.0 {
+                load(xs, &mut fp);
+            } else {
+                load(xs, &mut fm);
+                for i in 0..size {
+                    kt[(i, col)] -= (fp[i] - fm[i]) / (-2.0 * h);
+                }
+            }
+        });
+    }
+
+    /// The tangent by central differences of `force` (and of `extra`): translations and
+    /// spatial spins, exactly as `Model::apply_increment` composes them; `FD_STEP` relative.
+    /// The check of the consistent tangent, and the tangent of tets.
+    pub fn tangent_by_differences(
+        &self,
+        x: &[Vector3<f64>],
+        r: &[Matrix3<f64>],
+        state: &[f64],
+        extra: Option<&LoadFn>,
+    ) -> DMatrix<f64> {
+        let size = 6 * x.len();
+        let mut kt = DMatrix::zeros(size, size);
+        let (mut fp, mut fm) = (vec![0.0; size], vec![0.0; size]);
         let mut trial = vec![0.0; state.len()];
-        let mut minus_load = |xs: &[Vector3<f64>], out: &mut [f64]| {
+        let mut tmp = vec![0.0; size];
+        let mut eval = |xs: &[Vector3<f64>], rs: &[Matrix3<f64>], out: &mut [f64]| {
+            self.force(xs, rs, state, &mut trial, out);
             if let Some(g) = extra {
                 g(xs, &mut tmp);
                 for (o, t) in out.iter_mut().zip(&tmp) {
@@ -258,41 +317,10 @@ impl Element {
                 }
             }
         };
-        if let Body::Corotated { reference, k } = &self.body {
-            let mut d = vec![0.0; size];
-            let mut b = DMatrix::zeros(size, size);
-            reference.deformation(x, r, &mut d, Some(&mut b));
-            let fl = k * nalgebra::DVector::from_column_slice(&d);
-            let mut kt = b.transpose() * (k * &b);
-            // geometric part: forward differences of Bᵀ(q) f_l at fixed f_l
-            let mut geometric = |xs: &[Vector3<f64>], rs: &[Matrix3<f64>], out: &mut [f64]| {
-                let local = |_: &[f64], o: &mut [f64]| o.copy_from_slice(fl.as_slice());
-                reference.force(xs, rs, &mut d, local, out);
-                minus_load(xs, out);
-            };
-            let mut g0 = vec![0.0; size];
-            geometric(x, r, &mut g0);
-            let mut gp = vec![0.0; size];
-            Self::perturb(x, r, true, true, |xs, rs, col, h| {
-                geometric(xs, rs, &mut gp);
-                for i in 0..size {
-                    kt[(i, col)] += (gp[i] - g0[i]) / h;
-                }
-            });
-            return kt;
-        }
-        let mut kt = DMatrix::zeros(size, size);
-        let (mut fp, mut fm) = (vec![0.0; size], vec![0.0; size]);
-        let mut eval = |xs: &[Vector3<f64>], rs: &[Matrix3<f64>], out: &mut [f64]| {
-            self.force(xs, rs, state, &mut trial, out);
-            minus_load(xs, out);
-        };
-        let mut last = usize::MAX;
         // each column is visited with +h, then -h
-        Self::perturb(x, r, self.has_rotations(), false, |xs, rs, col, h| {
-            if col != last {
+        Self::perturb(x, r, self.has_rotations(), |xs, rs, col, h| {
+            if h > 0.0 {
                 eval(xs, rs, &mut fp);
-                last = col;
             } else {
                 eval(xs, rs, &mut fm);
                 for i in 0..size {
@@ -303,27 +331,25 @@ impl Element {
         kt
     }
 
-    /// Calls `visit(x', r', column, step)` for each perturbed configuration of the tangent:
-    /// translations moved by `±FD_STEP · size`, rotations by spatial spins `±FD_STEP`
-    /// (`forward`: `+` only; else `+` then `-` for each column); rotations only if `rotations`.
+    /// Calls `visit(x', r', column, step)` for each perturbed configuration of a
+    /// central-difference tangent: translations moved by `±FD_STEP · size`, rotations by spatial
+    /// spins `±FD_STEP`, `+` then `-` for each column; rotations only if `rotations`.
     fn perturb(
         x: &[Vector3<f64>],
         r: &[Matrix3<f64>],
         rotations: bool,
-        forward: bool,
         mut visit: impl FnMut(&[Vector3<f64>], &[Matrix3<f64>], usize, f64),
     ) {
         let n = x.len();
         let scale = (1..n).map(|i| (x[i] - x[0]).norm()).fold(0.0, f64::max).max(1e-300);
         let (mut xp, mut rp) = (x.to_vec(), r.to_vec());
-        let signs: &[f64] = if forward { &[1.0] } else { &[1.0, -1.0] };
         for j in 0..n {
             for c in 0..6 {
                 if c >= 3 && !rotations {
                     continue;
                 }
                 let h = if c < 3 { FD_STEP * scale } else { FD_STEP };
-                for sign in signs {
+                for sign in [1.0, -1.0] {
                     let s = sign * h;
                     if c < 3 {
                         xp[j][c] = x[j][c] + s;

@@ -9,7 +9,7 @@
 //! State: `[εp_xx, εp_yy, γp_xy, α]` per point, in-plane point major, in one flat array per
 //! element (the model double-buffers it for commit and revert).
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Matrix3};
 
 use super::section::ShellSection;
 use crate::material::j2::J2StatePlane;
@@ -65,23 +65,37 @@ impl LayeredJ2 {
     }
 
     /// Local force `fl` at local deformational displacements `d` from the committed state
-    /// `old`; writes the trial state into `new`.
-    pub fn force(&self, d: &[f64], old: &[f64], new: &mut [f64], fl: &mut [f64]) {
+    /// `old`; writes the trial state into `new`, and with `kl` the consistent local tangent
+    /// `K_lin + Σ_g w_g Σ_t (h/2) w_t (B_m + z_t B_b)ᵀ C_t (B_m + z_t B_b)` with `C_t` the
+    /// algorithmic tangent of the plane-stress return (Simo & Taylor 1986).
+    pub fn force(
+        &self,
+        d: &[f64],
+        old: &[f64],
+        new: &mut [f64],
+        fl: &mut [f64],
+        mut kl: Option<&mut DMatrix<f64>>,
+    ) {
         let n = d.len();
         let dv = nalgebra::DVectorView::from_slice(d, n);
         let mut f = &self.layers.k_linear * dv;
+        if let Some(k) = kl.as_deref_mut() {
+            k.copy_from(&self.layers.k_linear);
+        }
         let nt = self.rule.len();
         for (g, p) in self.layers.points.iter().enumerate() {
             let em = &p.bm * dv;
             let kap = &p.bb * dv;
             let (mut nres, mut mres) = ([0.0; 3], [0.0; 3]);
+            // Σ wt C, Σ wt z C, Σ wt z² C
+            let (mut c0, mut c1, mut c2) = (Matrix3::zeros(), Matrix3::zeros(), Matrix3::zeros());
             for (t, (&zeta, &w)) in self.rule.points.iter().zip(&self.rule.weights).enumerate() {
                 let z = 0.5 * self.h * zeta;
                 let eps = [em[0] + z * kap[0], em[1] + z * kap[1], em[2] + z * kap[2]];
                 let i = (g * nt + t) * POINT_STATE;
                 let s0 =
                     J2StatePlane { eps_p: [old[i], old[i + 1], old[i + 2]], alpha: old[i + 3] };
-                let (sigma, s1, _) = self.material.update_plane_stress(&eps, &s0);
+                let (sigma, s1, c) = self.material.update_plane_stress(&eps, &s0);
                 new[i..i + 3].copy_from_slice(&s1.eps_p);
                 new[i + 3] = s1.alpha;
                 let wt = 0.5 * self.h * w;
@@ -89,11 +103,22 @@ impl LayeredJ2 {
                     nres[k] += wt * sigma[k];
                     mres[k] += wt * z * sigma[k];
                 }
+                if kl.is_some() {
+                    let c = Matrix3::from_fn(|a, b| c[a][b]);
+                    c0 += wt * c;
+                    c1 += wt * z * c;
+                    c2 += wt * z * z * c;
+                }
             }
             // f += w_g (B_mᵀ N + B_bᵀ M)
             let (nv, mv) = (nalgebra::Vector3::from(nres), nalgebra::Vector3::from(mres));
             f.gemv_tr(p.weight, &p.bm, &nv, 1.0);
             f.gemv_tr(p.weight, &p.bb, &mv, 1.0);
+            if let Some(k) = kl.as_deref_mut() {
+                let (cm, cb) = (c0 * &p.bm + c1 * &p.bb, c1 * &p.bm + c2 * &p.bb);
+                k.gemm_tr(p.weight, &p.bm, &cm, 1.0);
+                k.gemm_tr(p.weight, &p.bb, &cb, 1.0);
+            }
         }
         fl.copy_from_slice(f.as_slice());
     }

@@ -46,6 +46,31 @@ pub fn tangent_inverse(theta: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::identity() - 0.5 * s + eta * s * s
 }
 
+/// `∂(T⁻ᵀ(θ) f)/∂θ` at fixed `f`: with `T⁻ᵀ f = f + ½ θ×f + η θ×(θ×f)`,
+/// `-½[f]× - η([θ×f]× + [θ]×[f]×) + μ (θ×(θ×f)) θᵀ`, `μ = η'(φ)/φ` (the `K_GM` term of
+/// Felippa & Haugen 2005, eq. 4.17; series for small `φ`).
+pub fn tangent_inverse_transpose_derivative(
+    theta: &Vector3<f64>,
+    f: &Vector3<f64>,
+) -> Matrix3<f64> {
+    let phi2 = theta.norm_squared();
+    let phi = phi2.sqrt();
+    let (eta, mu) = if phi < 0.05 {
+        (
+            1.0 / 12.0 + phi2 / 720.0 + phi2 * phi2 / 30240.0,
+            1.0 / 360.0 + phi2 / 7560.0 + phi2 * phi2 / 201600.0,
+        )
+    } else {
+        let half = 0.5 * phi;
+        let c = half / half.tan();
+        let dc = 0.5 / half.tan() - 0.25 * phi / (half.sin() * half.sin());
+        ((1.0 - c) / phi2, -dc / (phi2 * phi) - 2.0 * (1.0 - c) / (phi2 * phi2))
+    };
+    let tf = theta.cross(f);
+    -0.5 * spin(f) - eta * (spin(&tf) + spin(theta) * spin(f))
+        + mu * theta.cross(&tf) * theta.transpose()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -65,6 +90,23 @@ mod tests {
             let fd = (tp - tm) / (2.0 * h);
             let an = tinv.column(k);
             assert!((fd - an).norm() < 1e-8, "column {k}: fd {fd:?} analytic {an:?}");
+        }
+        // ∂(T⁻ᵀ f)/∂θ, both branches
+        let f = Vector3::new(0.3, 1.2, -0.7);
+        for theta in [Vector3::new(0.7, -1.1, 0.4), Vector3::new(0.01, -0.02, 0.03)] {
+            let an = tangent_inverse_transpose_derivative(&theta, &f);
+            for k in 0..3 {
+                let mut d = Vector3::zeros();
+                d[k] = h;
+                let fd = (tangent_inverse(&(theta + d)).transpose() * f
+                    - tangent_inverse(&(theta - d)).transpose() * f)
+                    / (2.0 * h);
+                assert!(
+                    (fd - an.column(k)).norm() < 1e-8,
+                    "∂T⁻ᵀf/∂θ column {k}: {fd:?} vs {:?}",
+                    an.column(k)
+                );
+            }
         }
         // small-angle branch
         let theta = Vector3::new(1e-4, 2e-4, -3e-4);

@@ -6,6 +6,12 @@
 //! [`CentralDifference::complete`] so that a coupled run (C0) can publish the predicted wet
 //! surface between them. Stable for `Δt <= 2/ω_max`; its discrete frequency obeys
 //! `cos ΩΔt = 1 - (ωΔt)²/2`.
+//!
+//! The kicks use the model's inverse mass (`Model::apply_inverse_mass`: rigid masters solve
+//! their 6x6 block) and the drift lets the model move dofs whose motion is not `Δt v`
+//! (`Model::explicit_drift`: the free flow of rigid bodies, Euler's equations included);
+//! dependent (rigid slave) velocities and accelerations follow their masters
+//! (`Model::dependent_motion`) at every full step.
 
 use super::{out_of_balance, prescribed_increment, Dynamics};
 use crate::model::Model;
@@ -16,7 +22,6 @@ pub struct CentralDifference {
     pub state: Dynamics,
     /// Velocity at the last half step, `v^{n+1/2}` after `advance_positions`.
     pub v_half: Vec<f64>,
-    m_inv: Vec<f64>,
     fi: Vec<f64>,
     r: Vec<f64>,
     du: Vec<f64>,
@@ -28,28 +33,25 @@ impl CentralDifference {
     pub fn new(model: &mut dyn Model, t0: f64, v0: Vec<f64>, extra: Option<&[f64]>) -> Self {
         let n = model.n_dof();
         assert_eq!(v0.len(), n, "initial velocity has the wrong length");
-        let m_inv = inverse_mass(model);
         let mut cd = CentralDifference {
             state: Dynamics { t: t0, v: v0, a: vec![0.0; n] },
             v_half: vec![0.0; n],
-            m_inv,
             fi: vec![0.0; n],
             r: vec![0.0; n],
             du: vec![0.0; n],
             scratch: vec![0.0; n],
         };
         cd.update_acceleration(model, t0, extra);
+        model.dependent_motion(&mut cd.state.v, &mut cd.state.a);
         cd
     }
 
     /// Resumes from a checkpointed state.
     pub fn resume(model: &dyn Model, state: Dynamics) -> Self {
         let n = model.n_dof();
-        let m_inv = inverse_mass(model);
         CentralDifference {
             state,
             v_half: vec![0.0; n],
-            m_inv,
             fi: vec![0.0; n],
             r: vec![0.0; n],
             du: vec![0.0; n],
@@ -59,9 +61,7 @@ impl CentralDifference {
 
     fn update_acceleration(&mut self, model: &mut dyn Model, t: f64, extra: Option<&[f64]>) {
         out_of_balance(model, t, extra, &mut self.fi, &mut self.r);
-        for ((a, r), mi) in self.state.a.iter_mut().zip(&self.r).zip(&self.m_inv) {
-            *a = r * mi;
-        }
+        model.apply_inverse_mass(&self.r, &mut self.state.a);
     }
 
     /// First half of a step: `v^{n+1/2}` and `u^{n+1}` (prescribed dofs follow their history).
@@ -77,6 +77,7 @@ impl CentralDifference {
                 self.du[i] = dt * self.v_half[i];
             }
         }
+        model.explicit_drift(dt, &mut self.v_half, &mut self.du);
         model.apply_increment(&self.du);
     }
 
@@ -87,6 +88,7 @@ impl CentralDifference {
         for ((v, vh), a) in self.state.v.iter_mut().zip(&self.v_half).zip(&self.state.a) {
             *v = vh + 0.5 * dt * a;
         }
+        model.dependent_motion(&mut self.state.v, &mut self.state.a);
         model.commit();
         self.state.t = t1;
     }
@@ -101,14 +103,4 @@ impl CentralDifference {
     pub fn internal_force(&self) -> &[f64] {
         &self.fi
     }
-}
-
-/// `1/m` on free dofs with mass, 0 elsewhere.
-fn inverse_mass(model: &dyn Model) -> Vec<f64> {
-    model
-        .lumped_mass()
-        .iter()
-        .zip(model.constrained())
-        .map(|(&m, &c)| if c || m <= 0.0 { 0.0 } else { 1.0 / m })
-        .collect()
 }

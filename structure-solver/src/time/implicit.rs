@@ -9,6 +9,12 @@
 //!   Newton tolerance; the A6 coupling feeds the fluid load `F^{n+1/2}` as `extra`.
 //!
 //! Both have the discrete frequency `tan(ΩΔt/2) = ωΔt/2` on a linear oscillator.
+//!
+//! The mass is the model's full mass (`Model::mass_product`, `Model::nondiagonal_mass`: the
+//! 6x6 blocks of rigid masters in the current orientation); rotations are treated as in the
+//! rest of the model (summed spins), so gyroscopic terms of rigid bodies are not integrated
+//! here (central differences integrate them). Rigid slaves follow their masters
+//! (`Model::dependent_motion`).
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::Triplet;
@@ -69,7 +75,11 @@ pub struct Implicit {
     du: Vec<f64>,
     delta: Vec<f64>,
     scratch: Vec<f64>,
+    /// Acceleration implied by `Δu` and the inertia force `M` times it.
+    acc: Vec<f64>,
+    inertia: Vec<f64>,
     triplets: Vec<Triplet<usize, usize, f64>>,
+    mass_triplets: Vec<Triplet<usize, usize, f64>>,
 }
 
 impl Implicit {
@@ -85,10 +95,8 @@ impl Implicit {
         assert_eq!(v0.len(), n, "initial velocity has the wrong length");
         let mut s = Self::resume(model, scheme, Dynamics { t: t0, v: v0, a: vec![0.0; n] });
         out_of_balance(model, t0, extra, &mut s.fi, &mut s.r);
-        let (m, c) = (model.lumped_mass(), model.constrained());
-        for i in 0..n {
-            s.state.a[i] = if c[i] || m[i] <= 0.0 { 0.0 } else { s.r[i] / m[i] };
-        }
+        model.apply_inverse_mass(&s.r, &mut s.state.a);
+        model.dependent_motion(&mut s.state.v, &mut s.state.a);
         s
     }
 
@@ -105,7 +113,10 @@ impl Implicit {
             du: vec![0.0; n],
             delta: vec![0.0; n],
             scratch: vec![0.0; n],
+            acc: vec![0.0; n],
+            inertia: vec![0.0; n],
             triplets: Vec::new(),
+            mass_triplets: Vec::new(),
         }
     }
 
@@ -118,13 +129,16 @@ impl Implicit {
         }
     }
 
-    /// Inertia term `M · (acceleration implied by Δu)` per dof.
-    fn inertia(&self, i: usize, m: f64, dt: f64) -> f64 {
-        let (v0, a0, du) = (self.state.v[i], self.state.a[i], self.du[i]);
-        match self.scheme {
-            ImplicitScheme::Newmark => m * (4.0 / (dt * dt) * (du - dt * v0) - a0),
-            ImplicitScheme::Midpoint => m * 2.0 * (du / dt - v0) / dt,
+    /// Inertia force `M · (acceleration implied by Δu)` into `self.inertia`.
+    fn inertia(&mut self, model: &dyn Model, dt: f64) {
+        for i in 0..self.acc.len() {
+            let (v0, a0, du) = (self.state.v[i], self.state.a[i], self.du[i]);
+            self.acc[i] = match self.scheme {
+                ImplicitScheme::Newmark => 4.0 / (dt * dt) * (du - dt * v0) - a0,
+                ImplicitScheme::Midpoint => 2.0 * (du / dt - v0) / dt,
+            };
         }
+        model.mass_product(&self.acc, &mut self.inertia);
     }
 
     /// Advances one step of `dt` with the extra load `extra` (held over the step; for the
@@ -158,12 +172,13 @@ impl Implicit {
         let mut last = (0.0, 0.0);
         for it in 0..=self.params.max_iter {
             out_of_balance(model, t_load, extra, &mut self.fi, &mut self.r);
+            self.inertia(model, dt);
             let (mut rn, mut reference) = (0.0, 0.0f64);
             for i in 0..n {
                 if constrained[i] {
                     continue;
                 }
-                let inertia = self.inertia(i, mass[i], dt);
+                let inertia = self.inertia[i];
                 reference = reference
                     .max(inertia.abs())
                     .max(self.fi[i].abs())
@@ -183,6 +198,11 @@ impl Implicit {
             // Jacobian cm M + ck K on the free dofs; solve J δ = r (r = -residual).
             self.triplets.clear();
             model.tangent(t_load, &mut self.triplets);
+            model.nondiagonal_mass(&mut self.mass_triplets);
+            let scale = cm / ck;
+            self.triplets.extend(
+                self.mass_triplets.iter().map(|e| Triplet::new(e.row, e.col, scale * e.val)),
+            );
             let lu = self
                 .solver
                 .factor(&self.triplets, ck, Some((cm, &mass)))
@@ -232,6 +252,7 @@ impl Implicit {
             self.fi.fill(0.0);
             model.internal_force(&mut self.fi);
         }
+        model.dependent_motion(&mut self.state.v, &mut self.state.a);
         model.commit();
         self.state.t += dt;
     }

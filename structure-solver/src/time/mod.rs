@@ -61,7 +61,10 @@ fn out_of_balance(
     }
 }
 
-/// Kinetic energy `½ vᵀ M v` with the lumped mass.
+/// Kinetic energy `½ vᵀ M v` with the model's mass (`Model::mass_product`: rigid bodies'
+/// full blocks).
 pub fn kinetic_energy(model: &dyn Model, v: &[f64]) -> f64 {
-    0.5 * model.lumped_mass().iter().zip(v).map(|(m, v)| m * v * v).sum::<f64>()
+    let mut mv = vec![0.0; v.len()];
+    model.mass_product(v, &mut mv);
+    0.5 * mv.iter().zip(v).map(|(p, v)| p * v).sum::<f64>()
 }
