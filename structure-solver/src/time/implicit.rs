@@ -33,12 +33,16 @@ pub enum ImplicitScheme {
 /// Newton settings of an implicit step.
 #[derive(Debug, Clone, Copy)]
 pub struct NewtonParams {
-    /// Relative tolerance on the free-dof residual: `|r| <= tol · max(|M a|, |f_int|, |f_ext|)`.
+    /// Relative tolerance on the free-dof residual: `|r|₂ <= tol · max(|M a|, |f_int|, |f_ext|)`
+    /// (max norms), or a residual that has stopped falling within 100 `tol` (the round-off floor).
     pub tol: f64,
     /// Absolute floor of the residual norm (forces), for states at rest.
     pub abs_tol: f64,
     pub max_iter: usize,
 }
+
+/// How far above the tolerance a residual that has stopped falling is accepted as round-off.
+const STALL_FACTOR: f64 = 100.0;
 
 impl Default for NewtonParams {
     fn default() -> Self {
@@ -169,7 +173,7 @@ impl Implicit {
         }
         model.apply_increment(&self.delta);
         let mass = model.lumped_mass().to_vec();
-        let mut last = (0.0, 0.0);
+        let mut last = (f64::INFINITY, 0.0);
         for it in 0..=self.params.max_iter {
             out_of_balance(model, t_load, extra, &mut self.fi, &mut self.r);
             self.inertia(model, dt);
@@ -187,8 +191,11 @@ impl Implicit {
                 rn += self.r[i] * self.r[i];
             }
             let rn = rn.sqrt();
+            // Newton has reached the round-off floor of the forces when a further iteration no
+            // longer halves the residual: accept that floor within `STALL_FACTOR` x the tolerance.
+            let stalled = rn > 0.5 * last.0 && rn <= STALL_FACTOR * self.params.tol * reference;
             last = (rn, reference);
-            if rn <= self.params.tol * reference || rn <= self.params.abs_tol {
+            if rn <= self.params.tol * reference || rn <= self.params.abs_tol || stalled {
                 self.finish(model, dt, stage);
                 return Ok(StepInfo { iterations: it, residual: rn / reference.max(1e-300) });
             }
