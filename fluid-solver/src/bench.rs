@@ -1,7 +1,18 @@
 //! `fluid-solver bench`: node-steps per second per core of RK2 + MUSCL (van Albada) + Roe on a
 //! perfect gas, on a box of tets with a non-uniform state, with 1 and 2 threads; memory per
-//! node; and the split of one residual into its passes. A node-step is one full RK2 step (two
-//! residuals) of one node (DESIGN §8).
+//! node (everything the solver holds: mesh, dual, gradient operator, state, scratch and stage
+//! arrays); the split of one step into its passes; and the cost of the edge loop alone per edge.
+//! A node-step is one full RK2 step (two residuals) of one node (DESIGN §8).
+//!
+//! `--dump-edges FILE` also writes the arrays of the edge loop in the raw format read by the C
+//! reference loop `fluid-solver/bench/edge_loop.c` (see `fluid-solver/bench/run-c-reference.sh`):
+//! all little-endian, in this order
+//! - header: 8 bytes magic `FIVEREDG`, `u64` nodes `N`, `u64` edges `E`, `f64` γ;
+//! - `E x [u32; 2]` edges `(i, j)`; `E x [f64; 3]` area normals `ν_ij`;
+//! - `N x [f64; 3]` coordinates; `N x [f64; 5]` primitives `[ρ, u, v, w, p]`;
+//! - `N x [[f64; 3]; 5]` primitive gradients;
+//! - `N x [f64; 5]` the edge residual `Σ_j ±F_ij` this solver computes from them (no boundary
+//!   fluxes), for checking the C loop.
 
 use crate::bc::BoundaryCondition;
 use crate::eos::Eos;
@@ -11,18 +22,27 @@ use crate::semidiscretization::{Numerics, Semidiscretization};
 use crate::state::{State, Workspace};
 use crate::time::{rk2_step, TimeStepping};
 use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
 use std::time::Instant;
 
 /// One measurement.
 #[derive(Debug, Clone, Serialize)]
 pub struct Measurement {
     pub threads: usize,
+    /// Median over the timed steps.
     pub seconds_per_step: f64,
+    /// Mean over the timed steps.
+    pub seconds_per_step_mean: f64,
+    /// From the median step.
     pub node_steps_per_second: f64,
     pub node_steps_per_second_per_core: f64,
-    /// Seconds of one residual spent in each pass (primitives, gradients, edge fluxes + gather +
-    /// boundary).
-    pub residual_split_seconds: std::collections::BTreeMap<String, f64>,
+    /// Seconds of each pass of one residual evaluation (medians): primitives, time steps (once
+    /// per RK2 step), gradients, edge fluxes + boundary fluxes (one pass).
+    pub residual_split_seconds: BTreeMap<String, f64>,
+    /// The edge flux loop alone (MUSCL + limiter + Roe + adding to both nodes), per edge.
+    pub edge_loop_ns_per_edge: f64,
 }
 
 /// The bench report.
@@ -32,19 +52,58 @@ pub struct BenchReport {
     pub nodes: usize,
     pub edges: usize,
     pub cells: usize,
+    pub edge_blocks: usize,
     pub steps: usize,
     pub mesh_build_seconds: f64,
     pub bytes_per_node: f64,
+    /// Bytes per node of each part.
+    pub bytes_per_node_split: BTreeMap<String, f64>,
     pub measurements: Vec<Measurement>,
+    /// Node-steps per second with 2 threads over 1 thread (when both were measured).
+    pub speedup_2_threads: Option<f64>,
 }
 
-/// Runs the bench on about `nodes` nodes for `steps` RK2 steps per thread count.
-pub fn run(nodes: usize, steps: usize) -> anyhow::Result<BenchReport> {
+/// Median of a non-empty list.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Median seconds of `reps` calls of `f`.
+fn time_median(reps: usize, mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64> {
+    let mut t = Vec::with_capacity(reps);
+    for _ in 0..reps {
+        let start = Instant::now();
+        f()?;
+        t.push(start.elapsed().as_secs_f64());
+    }
+    Ok(median(t))
+}
+
+/// Runs the bench on about `nodes` nodes for `steps` RK2 steps with each thread count of
+/// `threads`; with `dump_edges`, also writes the edge-loop arrays there (see the module docs).
+pub fn run(
+    nodes: usize,
+    steps: usize,
+    threads: &[usize],
+    dump_edges: Option<&Path>,
+) -> anyhow::Result<BenchReport> {
+    anyhow::ensure!(steps > 0, "--steps must be at least 1");
+    anyhow::ensure!(
+        !threads.is_empty() && threads.iter().all(|&t| t > 0),
+        "--threads must list thread counts of at least 1, e.g. 1,2"
+    );
     let n = ((nodes as f64).cbrt().round() as usize).max(3) - 1;
     let start = Instant::now();
     let mesh = Mesh::build(BoxSpec::uniform([0.0; 3], [1.0; 3], [n, n, n], BoxCells::Tet).raw()?)?;
     let mesh_build_seconds = start.elapsed().as_secs_f64();
-    let eos = Eos::PerfectGas { gamma: 1.4 };
+    let gamma = 1.4;
+    let eos = Eos::PerfectGas { gamma };
     let free = [1.0, 0.3, 0.1, 0.0, 1.0];
     let bcs: Vec<(String, BoundaryCondition)> = FACE_NAMES
         .iter()
@@ -62,61 +121,112 @@ pub fn run(nodes: usize, steps: usize) -> anyhow::Result<BenchReport> {
             })
             .collect(),
     };
+    let n_nodes = semi.mesh.n_nodes();
     let mut measurements = Vec::new();
-    let mut bytes = 0;
-    for threads in [1, 2] {
+    let mut split_bytes = BTreeMap::new();
+    let mut dumped = false;
+    for &threads in threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let m = pool.install(|| -> anyhow::Result<Measurement> {
-            let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+            let mut ws = Workspace::new(n_nodes, semi.mesh.n_edges());
             let mut state = initial.clone();
-            // Warm up, then time.
-            rk2_step(&semi, &mut state, &mut ws, TimeStepping::Global { cfl: 0.9 }, 1.0)?;
-            let start = Instant::now();
+            let stepping = TimeStepping::Global { cfl: 0.9 };
+            // Warm up, then time each step.
+            rk2_step(&semi, &mut state, &mut ws, stepping, 1.0)?;
+            let mut per_step = Vec::with_capacity(steps);
             for _ in 0..steps {
-                rk2_step(&semi, &mut state, &mut ws, TimeStepping::Global { cfl: 0.9 }, 1.0)?;
+                let start = Instant::now();
+                rk2_step(&semi, &mut state, &mut ws, stepping, 1.0)?;
+                per_step.push(start.elapsed().as_secs_f64());
             }
-            let per_step = start.elapsed().as_secs_f64() / steps as f64;
-            let mut split = std::collections::BTreeMap::new();
-            let reps = 3;
-            let t0 = Instant::now();
-            for _ in 0..reps {
-                semi.primitives(&state.cons, &mut ws)?;
-            }
-            split.insert("primitives".to_string(), t0.elapsed().as_secs_f64() / reps as f64);
-            let t0 = Instant::now();
-            for _ in 0..reps {
+            let mean = per_step.iter().sum::<f64>() / steps as f64;
+            let step = median(per_step);
+            let reps = 5;
+            let mut split = BTreeMap::new();
+            let t = time_median(reps, || Ok(semi.primitives(&state.cons, &mut ws)?))?;
+            split.insert("primitives".to_string(), t);
+            let t = time_median(reps, || {
+                semi.node_time_steps(&mut ws);
+                Ok(())
+            })?;
+            split.insert("time_steps".to_string(), t);
+            let t = time_median(reps, || {
                 semi.gradient.compute(&semi.mesh, &ws.prim, &mut ws.grad);
+                Ok(())
+            })?;
+            split.insert("gradients".to_string(), t);
+            let full = time_median(reps, || Ok(semi.residual_from_primitives(&mut ws)?))?;
+            split.insert("fluxes_and_boundary".to_string(), full - split["gradients"]);
+            let edge_loop = time_median(reps, || {
+                semi.edge_residual(&mut ws);
+                Ok(())
+            })?;
+            if let Some(path) = dump_edges.filter(|_| !dumped) {
+                dump(path, &semi, &ws, gamma)?;
+                dumped = true;
             }
-            split.insert("gradients".to_string(), t0.elapsed().as_secs_f64() / reps as f64);
-            let t0 = Instant::now();
-            for _ in 0..reps {
-                semi.residual_from_primitives(&mut ws)?;
-            }
-            let full = t0.elapsed().as_secs_f64() / reps as f64;
-            split.insert("fluxes_gather_boundary".to_string(), full - split["gradients"]);
-            bytes = semi.mesh.memory_bytes()
-                + semi.gradient.memory_bytes()
-                + ws.memory_bytes()
-                + state.cons.len() * 40;
-            let rate = semi.mesh.n_nodes() as f64 / per_step;
+            split_bytes.insert("mesh".to_string(), semi.mesh.memory_bytes());
+            split_bytes.insert("gradient_operator".to_string(), semi.gradient.memory_bytes());
+            split_bytes.insert("workspace".to_string(), ws.memory_bytes());
+            split_bytes.insert("state".to_string(), std::mem::size_of_val(&state.cons[..]));
+            let rate = n_nodes as f64 / step;
             Ok(Measurement {
                 threads,
-                seconds_per_step: per_step,
+                seconds_per_step: step,
+                seconds_per_step_mean: mean,
                 node_steps_per_second: rate,
                 node_steps_per_second_per_core: rate / threads as f64,
                 residual_split_seconds: split,
+                edge_loop_ns_per_edge: edge_loop / semi.mesh.n_edges() as f64 * 1e9,
             })
         })?;
         measurements.push(m);
     }
+    let bytes: usize = split_bytes.values().sum();
+    let rate_with =
+        |t: usize| measurements.iter().find(|m| m.threads == t).map(|m| m.node_steps_per_second);
     Ok(BenchReport {
         scheme: "RK2 (TVD) + MUSCL (van Albada, LSQ gradients) + Roe, perfect gas, tets",
-        nodes: semi.mesh.n_nodes(),
+        nodes: n_nodes,
         edges: semi.mesh.n_edges(),
         cells: semi.mesh.cells.len(),
+        edge_blocks: semi.mesh.blocks.len(),
         steps,
         mesh_build_seconds,
-        bytes_per_node: bytes as f64 / semi.mesh.n_nodes() as f64,
+        bytes_per_node: bytes as f64 / n_nodes as f64,
+        bytes_per_node_split: split_bytes
+            .into_iter()
+            .map(|(k, v)| (k, v as f64 / n_nodes as f64))
+            .collect(),
+        speedup_2_threads: rate_with(1).zip(rate_with(2)).map(|(one, two)| two / one),
         measurements,
     })
+}
+
+/// Writes the edge-loop arrays and the edge residual in `ws` (see the module docs).
+fn dump(path: &Path, semi: &Semidiscretization, ws: &Workspace, gamma: f64) -> anyhow::Result<()> {
+    let mesh = &semi.mesh;
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    out.write_all(b"FIVEREDG")?;
+    out.write_all(&(mesh.n_nodes() as u64).to_le_bytes())?;
+    out.write_all(&(mesh.n_edges() as u64).to_le_bytes())?;
+    out.write_all(&gamma.to_le_bytes())?;
+    for e in &mesh.edges {
+        for v in e {
+            out.write_all(&v.to_le_bytes())?;
+        }
+    }
+    let mut put = |values: &mut dyn Iterator<Item = f64>| -> std::io::Result<()> {
+        for v in values {
+            out.write_all(&v.to_le_bytes())?;
+        }
+        Ok(())
+    };
+    put(&mut mesh.edge_normals.iter().flatten().copied())?;
+    put(&mut mesh.coords.iter().flatten().copied())?;
+    put(&mut ws.prim.iter().flatten().copied())?;
+    put(&mut ws.grad.iter().flatten().flatten().copied())?;
+    put(&mut ws.residual.iter().flatten().copied())?;
+    out.flush()?;
+    Ok(())
 }

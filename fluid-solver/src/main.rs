@@ -41,6 +41,13 @@ enum Command {
         /// RK2 steps per measurement.
         #[arg(long, default_value_t = 10)]
         steps: usize,
+        /// Thread counts to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// Also write the edge-loop arrays to this file for the C reference loop
+        /// (fluid-solver/bench/run-c-reference.sh).
+        #[arg(long, value_name = "FILE")]
+        dump_edges: Option<PathBuf>,
     },
 }
 
@@ -48,9 +55,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run { args, restart, force } => run(&args, restart, force),
-        Command::Bench { nodes, steps } => bench::run(nodes, steps).map(|report| {
-            println!("{}", serde_json::to_string_pretty(&report).expect("JSON"));
-        }),
+        Command::Bench { nodes, steps, threads, dump_edges } => {
+            bench::run(nodes, steps, &threads, dump_edges.as_deref()).map(|report| {
+                println!("{}", serde_json::to_string_pretty(&report).expect("JSON"));
+            })
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,43 +1,45 @@
 //! The residual of the semi-discrete Euler equations (thesis Eq. 3.6-3.7):
 //! `|C_i| dW_i/dt + R_i(W) = 0`, `R_i = Σ_{j ∈ K(i)} F_ij(W_ij, W_ji, EOS, ν_ij) + Σ_b F_b(W_i, n_i)`.
 //!
-//! Evaluated in a deterministic two-pass form, so the result is bitwise the same for any number
-//! of threads:
-//! 1. per edge (rayon over blocks of consecutive edges, sorted by `(i, j)` so the gathers of a
-//!    block touch nearby nodes): MUSCL states at the edge midpoint from the nodal least-squares
-//!    gradients of the primitive variables, limited ([`crate::reconstruct`]), then the numerical
-//!    flux into the edge buffer;
-//! 2. per node (rayon over nodes): the sum of the fluxes of its edges in ascending edge order over
-//!    the node-to-edge CSR (`+F` where the node is `i`, `-F` where it is `j`), then the boundary
-//!    fluxes of its boundary facets, patch by patch in a fixed order.
+//! Evaluated in one deterministic pass over the edges, in the blocks of [`crate::mesh::EdgeBlocks`]
+//! (even blocks in parallel, then odd blocks): per edge, the MUSCL states at the edge midpoint from
+//! the nodal least-squares gradients of the primitive variables, limited ([`crate::reconstruct`];
+//! mirror-symmetric at the nodes on symmetry planes and plane slip walls,
+//! [`crate::reconstruct::gradient`]), then the numerical flux, added at once to `R_i` (`+F`) and
+//! `R_j` (`-F`); per block, the boundary fluxes of its nodes, patch by patch in a fixed order.
+//! Every node hears from its edges in an order fixed by the mesh, so the result is bitwise the same
+//! for any number of threads, and no per-edge flux buffer or gather pass is needed. A node's
+//! residual is complete inside the same pass, so the time integrator applies its update there
+//! ([`Semidiscretization::residual_and_update`]) while the node is still in cache.
 //!
 //! Extension points:
 //! - Embedded boundary (thesis Ch. 4-5): a cut edge gets two one-sided fluxes (Alg. 5.1 for each
-//!   active end node). Pass 1 then writes `F_ij` for node `i` into `edge_flux` and `F_ji` for node
-//!   `j` into a per-cut-edge side buffer indexed by the edge; pass 2 reads that buffer for `j` on
-//!   cut edges. Inactive nodes are masked in pass 2 (zero residual, state frozen), and the gradient
-//!   operator is rebuilt with the cut edges masked out ([`LsqGradient::with_mask`]).
+//!   active end node): the edge loop adds `F_ij` to `R_i` and `F_ji` to `R_j`. Inactive nodes are
+//!   masked when their residual completes (zero residual, state frozen), and the gradient
+//!   operator is rebuilt with the cut edges masked out and the same mirror planes
+//!   ([`LsqGradient::with_planes`]).
 //! - Two-phase (thesis Ch. 3): a per-node material id selects the EOS of each end; an edge whose
 //!   ends hold different fluids takes [`crate::flux::two_phase_flux`] (again two one-sided fluxes,
-//!   stored as for cut edges); the level set is one more nodal array advected by the same loop.
-//! - MPI (DESIGN §10): with owned nodes first and ghosts after, pass 1 runs over edges touching an
-//!   owned node, pass 2 over owned nodes only, and a ghost exchange precedes each stage.
+//!   added as for cut edges); the level set is one more nodal array advected by the same loop.
+//! - MPI (DESIGN §10): with owned nodes first and ghosts after, the edge loop runs over edges
+//!   touching an owned node, the update over owned nodes only, and a ghost exchange precedes each
+//!   stage.
 
 use crate::bc::BoundaryCondition;
 use crate::eos::{Eos, StateError};
 use crate::flux::{numerical_flux, FluxScheme};
-use crate::mesh::geometry::{dot, norm, sub};
+use crate::mesh::blocks::Window;
+use crate::mesh::geometry::{dot, sub};
 use crate::mesh::{Mesh, MeshError};
-use crate::reconstruct::gradient::LsqGradient;
+use crate::reconstruct::gradient::{LsqGradient, MirrorPlanes};
 use crate::reconstruct::limiter::Limiter;
 use crate::reconstruct::muscl;
 use crate::riemann::RiemannError;
 use crate::state::Workspace;
 use rayon::prelude::*;
+use std::ops::Range;
 
-/// Edges per parallel block of pass 1.
-const EDGE_BLOCK: usize = 2048;
-/// Nodes per parallel block of pass 2.
+/// Nodes per parallel block of the node loops.
 const NODE_BLOCK: usize = 1024;
 
 /// Spatial scheme settings.
@@ -102,17 +104,37 @@ impl Semidiscretization {
                 )));
             }
         }
-        let gradient = LsqGradient::new(&mesh);
+        // Symmetry planes and plane slip walls: mirror-symmetric gradients there.
+        let mirrors: Vec<usize> = patches
+            .iter()
+            .filter(|p| matches!(p.1, BoundaryCondition::Symmetry | BoundaryCondition::SlipWall))
+            .map(|p| p.0)
+            .collect();
+        let planes = MirrorPlanes::new(&mesh, &mirrors);
+        let gradient = LsqGradient::with_planes(&mesh, None, planes);
         Ok(Semidiscretization { mesh, eos, numerics, gradient, patches })
     }
 
     /// Primitive variables of every node into `ws.prim`, checked against the EOS.
     pub fn primitives(&self, cons: &[[f64; 5]], ws: &mut Workspace) -> Result<(), FluidError> {
         let eos = self.eos;
-        ws.prim.par_iter_mut().zip(cons.par_iter()).with_min_len(NODE_BLOCK).for_each(|(w, q)| {
-            *w = eos.cons_to_prim(q);
-        });
-        if let Some(node) = ws.prim.par_iter().position_first(|w| eos.check(w).is_err()) {
+        let first_bad = ws
+            .prim
+            .par_chunks_mut(NODE_BLOCK)
+            .zip(cons.par_chunks(NODE_BLOCK))
+            .enumerate()
+            .filter_map(|(b, (prim, cons))| {
+                let mut bad = None;
+                for (k, (w, q)) in prim.iter_mut().zip(cons).enumerate() {
+                    *w = eos.cons_to_prim(q);
+                    if bad.is_none() && eos.check(w).is_err() {
+                        bad = Some(b * NODE_BLOCK + k);
+                    }
+                }
+                bad
+            })
+            .min();
+        if let Some(node) = first_bad {
             let prim = ws.prim[node];
             let error = eos.check(&prim).expect_err("found invalid above");
             return Err(FluidError::InvalidState {
@@ -133,83 +155,180 @@ impl Semidiscretization {
 
     /// The residual from the primitive variables already in `ws.prim`.
     pub fn residual_from_primitives(&self, ws: &mut Workspace) -> Result<(), FluidError> {
-        let mesh = &self.mesh;
-        let eos = self.eos;
-        let numerics = self.numerics;
-        let second_order = numerics.second_order();
-        if second_order {
-            self.gradient.compute(mesh, &ws.prim, &mut ws.grad);
-        }
-        // Pass 1: edge fluxes.
-        let prim = &ws.prim;
-        let grad = &ws.grad;
-        ws.edge_flux.par_chunks_mut(EDGE_BLOCK).enumerate().for_each(|(b, block)| {
-            let first = b * EDGE_BLOCK;
-            for (k, f) in block.iter_mut().enumerate() {
-                let e = first + k;
-                let [i, j] = mesh.edges[e];
-                let (i, j) = (i as usize, j as usize);
-                let n = &mesh.edge_normals[e];
-                *f = if second_order {
-                    let d = sub(mesh.coords[j], mesh.coords[i]);
-                    let (wl, wr) = muscl::reconstruct(
-                        numerics.limiter,
-                        &eos,
-                        &prim[i],
-                        &grad[i],
-                        &eos,
-                        &prim[j],
-                        &grad[j],
-                        &d,
-                    );
-                    numerical_flux(numerics.flux, &eos, &wl, &wr, n)
-                } else {
-                    numerical_flux(numerics.flux, &eos, &prim[i], &prim[j], n)
-                };
-            }
-        });
-        // Pass 2: per-node gather in ascending edge order.
-        let edge_flux = &ws.edge_flux;
-        ws.residual.par_iter_mut().enumerate().with_min_len(NODE_BLOCK).for_each(|(i, r)| {
-            let mut s = [0.0; 5];
-            for &e in mesh.edges_of(i) {
-                let f = &edge_flux[e as usize];
-                if mesh.edges[e as usize][0] as usize == i {
-                    for k in 0..5 {
-                        s[k] += f[k];
-                    }
-                } else {
-                    for k in 0..5 {
-                        s[k] -= f[k];
-                    }
-                }
-            }
-            *r = s;
-        });
-        self.add_boundary_fluxes(&ws.prim, &mut ws.residual)
+        let mut none = vec![(); self.mesh.n_nodes()];
+        self.residual_and_update(ws, &mut none, |_, _, _| {})
     }
 
-    /// Adds the boundary fluxes, patch by patch (sequential: a fixed order, few nodes).
-    fn add_boundary_fluxes(
+    /// The residual from `ws.prim` into `ws.residual`, calling `update(i, R_i, &mut out[i])` for
+    /// every node as soon as its residual is complete (within the same pass over the edges, in
+    /// parallel). On error `out` may be partly updated.
+    pub fn residual_and_update<U: Send>(
         &self,
+        ws: &mut Workspace,
+        out: &mut [U],
+        update: impl Fn(usize, &[f64; 5], &mut U) + Sync,
+    ) -> Result<(), FluidError> {
+        let mesh = &self.mesh;
+        if self.numerics.second_order() {
+            self.gradient.compute(mesh, &ws.prim, &mut ws.grad);
+        }
+        let Workspace { prim, grad, residual, .. } = ws;
+        let (prim, grad) = (&prim[..], &grad[..]);
+        let blocks = &mesh.blocks;
+        blocks.scatter2(residual, out, |b, r, o| {
+            for i in blocks.fresh(b) {
+                r[i] = [0.0; 5];
+            }
+            self.edge_fluxes(blocks.edges(b), prim, grad, r);
+            self.boundary_fluxes(blocks.nodes(b), prim, r)?;
+            for i in blocks.completed(b) {
+                update(i, &r[i], &mut o[i]);
+            }
+            Ok(())
+        })
+    }
+
+    /// Only the edge part of the residual, `Σ_j F_ij` without boundary fluxes, from `ws.prim` and
+    /// the gradients already in `ws.grad` (the hot loop alone, for benchmarks and for checking the
+    /// C reference loop of `fluid-solver/bench/`).
+    pub fn edge_residual(&self, ws: &mut Workspace) {
+        let Workspace { prim, grad, residual, .. } = ws;
+        let (prim, grad) = (&prim[..], &grad[..]);
+        let blocks = &self.mesh.blocks;
+        let result = blocks.scatter(residual, |b, r| {
+            for i in blocks.fresh(b) {
+                r[i] = [0.0; 5];
+            }
+            self.edge_fluxes(blocks.edges(b), prim, grad, r);
+            Ok::<(), std::convert::Infallible>(())
+        });
+        let Ok(()) = result;
+    }
+
+    /// Adds the fluxes of `edges` to the residuals of their end nodes, with the scheme's limiter,
+    /// flux and EOS fixed outside the edge loop (so each combination is its own tight loop).
+    fn edge_fluxes(
+        &self,
+        edges: Range<usize>,
         prim: &[[f64; 5]],
-        residual: &mut [[f64; 5]],
+        grad: &[[[f64; 3]; 5]],
+        r: &mut Window<'_, [f64; 5]>,
+    ) {
+        let limiter = self.numerics.limiter;
+        match self.eos {
+            Eos::PerfectGas { gamma } => {
+                self.edge_loop(Eos::PerfectGas { gamma }, limiter, edges, prim, grad, r)
+            }
+            Eos::StiffenedGas { gamma, p_c } => {
+                self.edge_loop(Eos::StiffenedGas { gamma, p_c }, limiter, edges, prim, grad, r)
+            }
+            Eos::Tait { p0, rho0, alpha, beta } => {
+                self.edge_loop(Eos::Tait { p0, rho0, alpha, beta }, limiter, edges, prim, grad, r)
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn edge_loop(
+        &self,
+        eos: Eos,
+        limiter: Limiter,
+        edges: Range<usize>,
+        prim: &[[f64; 5]],
+        grad: &[[[f64; 3]; 5]],
+        r: &mut Window<'_, [f64; 5]>,
+    ) {
+        match (self.numerics.flux, limiter) {
+            (FluxScheme::Roe, Limiter::FirstOrder) => {
+                self.edge_loop_with(eos, Limiter::FirstOrder, FluxScheme::Roe, edges, prim, grad, r)
+            }
+            (FluxScheme::Roe, Limiter::Unlimited) => {
+                self.edge_loop_with(eos, Limiter::Unlimited, FluxScheme::Roe, edges, prim, grad, r)
+            }
+            (FluxScheme::Roe, Limiter::Minmod) => {
+                self.edge_loop_with(eos, Limiter::Minmod, FluxScheme::Roe, edges, prim, grad, r)
+            }
+            (FluxScheme::Roe, Limiter::VanAlbada) => {
+                self.edge_loop_with(eos, Limiter::VanAlbada, FluxScheme::Roe, edges, prim, grad, r)
+            }
+            (FluxScheme::Hllc, Limiter::FirstOrder) => self.edge_loop_with(
+                eos,
+                Limiter::FirstOrder,
+                FluxScheme::Hllc,
+                edges,
+                prim,
+                grad,
+                r,
+            ),
+            (FluxScheme::Hllc, Limiter::Unlimited) => {
+                self.edge_loop_with(eos, Limiter::Unlimited, FluxScheme::Hllc, edges, prim, grad, r)
+            }
+            (FluxScheme::Hllc, Limiter::Minmod) => {
+                self.edge_loop_with(eos, Limiter::Minmod, FluxScheme::Hllc, edges, prim, grad, r)
+            }
+            (FluxScheme::Hllc, Limiter::VanAlbada) => {
+                self.edge_loop_with(eos, Limiter::VanAlbada, FluxScheme::Hllc, edges, prim, grad, r)
+            }
+        }
+    }
+
+    /// The edge loop of one scheme: MUSCL states, flux, `R_i += F`, `R_j -= F`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn edge_loop_with(
+        &self,
+        eos: Eos,
+        limiter: Limiter,
+        flux: FluxScheme,
+        edges: Range<usize>,
+        prim: &[[f64; 5]],
+        grad: &[[[f64; 3]; 5]],
+        r: &mut Window<'_, [f64; 5]>,
+    ) {
+        let mesh = &self.mesh;
+        for e in edges {
+            let [i, j] = mesh.edges[e];
+            let (i, j) = (i as usize, j as usize);
+            let n = &mesh.edge_normals[e];
+            let f = if limiter == Limiter::FirstOrder {
+                numerical_flux(flux, &eos, &prim[i], &prim[j], n)
+            } else {
+                let d = sub(mesh.coords[j], mesh.coords[i]);
+                let (wl, wr) = muscl::reconstruct(
+                    limiter, &eos, &prim[i], &grad[i], &eos, &prim[j], &grad[j], &d,
+                );
+                numerical_flux(flux, &eos, &wl, &wr, n)
+            };
+            for k in 0..5 {
+                r[i][k] += f[k];
+            }
+            for k in 0..5 {
+                r[j][k] -= f[k];
+            }
+        }
+    }
+
+    /// Adds the boundary fluxes of the boundary nodes in `nodes`, patch by patch.
+    fn boundary_fluxes(
+        &self,
+        nodes: Range<usize>,
+        prim: &[[f64; 5]],
+        r: &mut Window<'_, [f64; 5]>,
     ) -> Result<(), FluidError> {
         for &(b, bc) in &self.patches {
             let boundary = &self.mesh.boundaries[b];
-            for (&node, n) in boundary.nodes.iter().zip(&boundary.normals) {
-                let node = node as usize;
-                let f =
-                    bc.flux(self.numerics.flux, &self.eos, &prim[node], n).map_err(|error| {
-                        FluidError::Boundary {
-                            boundary: boundary.name.clone(),
-                            node,
-                            position: self.mesh.coords[node],
-                            error,
-                        }
-                    })?;
-                for k in 0..5 {
-                    residual[node][k] += f[k];
+            for k in node_range(&boundary.nodes, &nodes) {
+                let node = boundary.nodes[k] as usize;
+                let f = bc
+                    .flux(self.numerics.flux, &self.eos, &prim[node], &boundary.normals[k])
+                    .map_err(|error| FluidError::Boundary {
+                    boundary: boundary.name.clone(),
+                    node,
+                    position: self.mesh.coords[node],
+                    error,
+                })?;
+                for c in 0..5 {
+                    r[node][c] += f[c];
                 }
             }
         }
@@ -221,39 +340,47 @@ impl Semidiscretization {
     /// CFL the Courant number `(|u| + c) Δt / Δx` on a 1D grid (each direction's flux enters
     /// through two facets); on 3D grids the sum over all facets makes the same CFL about 1/3 of
     /// that per direction, and on one-cell-thick tubes the lateral and symmetry facets (which carry
-    /// no waves) make it smaller still.
+    /// no waves) make it smaller still. The sound speed term is `c_i` times the dual cell's area
+    /// ([`Mesh::dual_areas`]); the convective sums take one pass over the edge blocks, like the
+    /// residual.
     pub fn node_time_steps(&self, ws: &mut Workspace) {
         let mesh = &self.mesh;
         let eos = self.eos;
-        let prim = &ws.prim;
-        ws.dt_node.par_iter_mut().enumerate().with_min_len(NODE_BLOCK).for_each(|(i, dt)| {
-            let w = &prim[i];
-            let u = [w[1], w[2], w[3]];
-            let c = eos.sound_speed(w[0], w[4]);
-            let mut lambda = 0.0;
-            for &e in mesh.edges_of(i) {
-                let n = mesh.edge_normals[e as usize];
-                lambda += dot(u, n).abs() + c * norm(n);
+        let prim = &ws.prim[..];
+        let blocks = &mesh.blocks;
+        let u_dot = |w: &[f64; 5], n: &[f64; 3]| dot([w[1], w[2], w[3]], *n).abs();
+        let result = blocks.scatter(&mut ws.dt_node, |b, lambda| {
+            for i in blocks.fresh(b) {
+                lambda[i] = 0.0;
             }
-            *dt = 2.0 * mesh.volumes[i] / lambda;
-        });
-        for b in &mesh.boundaries {
-            for (&node, n) in b.nodes.iter().zip(&b.normals) {
-                let i = node as usize;
+            for e in blocks.edges(b) {
+                let [i, j] = mesh.edges[e];
+                let (i, j) = (i as usize, j as usize);
+                let n = &mesh.edge_normals[e];
+                lambda[i] += u_dot(&prim[i], n);
+                lambda[j] += u_dot(&prim[j], n);
+            }
+            for boundary in &mesh.boundaries {
+                for k in node_range(&boundary.nodes, &blocks.nodes(b)) {
+                    let i = boundary.nodes[k] as usize;
+                    lambda[i] += u_dot(&prim[i], &boundary.normals[k]);
+                }
+            }
+            for i in blocks.completed(b) {
                 let w = &prim[i];
                 let c = eos.sound_speed(w[0], w[4]);
-                let extra = dot([w[1], w[2], w[3]], *n).abs() + c * norm(*n);
-                // dt = 2V / λ  ->  2V / (λ + extra).
-                let lambda = 2.0 * mesh.volumes[i] / ws.dt_node[i];
-                ws.dt_node[i] = 2.0 * mesh.volumes[i] / (lambda + extra);
+                lambda[i] = 2.0 * mesh.volumes[i] / (lambda[i] + c * mesh.dual_areas[i]);
             }
-        }
+            Ok::<(), std::convert::Infallible>(())
+        });
+        let Ok(()) = result;
     }
 
     /// `Σ_i R_i` and the total boundary flux `Σ_b F_b`, for conservation checks.
     pub fn boundary_flux_total(&self, prim: &[[f64; 5]]) -> Result<[f64; 5], FluidError> {
         let mut total = vec![[0.0; 5]; prim.len()];
-        self.add_boundary_fluxes(prim, &mut total)?;
+        let nodes = 0..prim.len();
+        self.boundary_fluxes(nodes.clone(), prim, &mut Window::new(nodes.start, &mut total))?;
         let mut s = [0.0; 5];
         for r in &total {
             for k in 0..5 {
@@ -262,4 +389,10 @@ impl Semidiscretization {
         }
         Ok(s)
     }
+}
+
+/// The positions in the ascending node list `list` of the nodes in `nodes`.
+fn node_range(list: &[u32], nodes: &Range<usize>) -> Range<usize> {
+    list.partition_point(|&v| (v as usize) < nodes.start)
+        ..list.partition_point(|&v| (v as usize) < nodes.end)
 }

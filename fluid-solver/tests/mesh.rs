@@ -23,15 +23,25 @@ fn check_invariants(raw: RawMesh, volume: f64) -> Mesh {
     assert!((total - volume).abs() < 1e-12 * volume, "dual volumes {total} vs domain {volume}");
     assert!(mesh.volumes.iter().all(|&v| v > 0.0));
     let scale = mesh.edge_normals.iter().map(|n| norm(*n)).fold(0.0, f64::max);
-    for i in 0..mesh.n_nodes() {
-        let d = norm(mesh.closure_defect(i));
+    for (i, defect) in mesh.closure_defects().into_iter().enumerate() {
+        let d = norm(defect);
         assert!(d < 1e-13 * scale, "node {i}: closure defect {d:e}");
     }
-    // Edges sorted by (i, j) with i < j, node-to-edge rows ascending.
+    // Edges sorted by (i, j) with i < j; the edge blocks cover all edges in order, and each
+    // block's edges stay inside its window.
     assert!(mesh.edges.windows(2).all(|w| w[0] < w[1]));
     assert!(mesh.edges.iter().all(|e| e[0] < e[1]));
-    for i in 0..mesh.n_nodes() {
-        assert!(mesh.edges_of(i).windows(2).all(|w| w[0] < w[1]));
+    let blocks = &mesh.blocks;
+    assert_eq!(blocks.edges(0).start, 0);
+    assert_eq!(blocks.edges(blocks.len() - 1).end, mesh.n_edges());
+    for b in 0..blocks.len() {
+        if b > 0 {
+            assert_eq!(blocks.edges(b).start, blocks.edges(b - 1).end);
+        }
+        let (nodes, window) = (blocks.nodes(b), blocks.window(b));
+        for &[i, j] in &mesh.edges[blocks.edges(b)] {
+            assert!(nodes.contains(&(i as usize)) && window.contains(&(j as usize)), "block {b}");
+        }
     }
     mesh
 }

@@ -95,6 +95,8 @@ fn five_steps(threads: usize) -> Vec<[f64; 5]> {
         let mesh = perturbed_box([14, 12, 10], [1.0; 3], 9);
         let bc = BoundaryCondition::FarField { state: [1.0, 0.1, 0.0, 0.0, 1.0] };
         let semi = Semidiscretization::new(mesh, GAS, Numerics::default(), &all(bc)).unwrap();
+        // Enough edge blocks that both threads get some in each phase.
+        assert!(semi.mesh.blocks.len() >= 6, "{} edge blocks", semi.mesh.blocks.len());
         let mut state =
             State { cons: semi.mesh.coords.iter().map(|&x| GAS.prim_to_cons(&wavy(x))).collect() };
         let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());

@@ -5,7 +5,7 @@
 use super::cell::edge_faces;
 use super::geometry::{add, centroid, cross, dot, norm, scale, sub};
 use super::renumber::reverse_cuthill_mckee;
-use super::{Boundary, Cell, Mesh, MeshError, RawMesh};
+use super::{Boundary, Cell, EdgeBlocks, Mesh, MeshError, RawMesh};
 
 /// Node adjacency through cell edges as CSR (sorted neighbour lists, no self).
 fn adjacency(n: usize, cells: &[Cell]) -> (Vec<usize>, Vec<u32>) {
@@ -194,24 +194,6 @@ pub(super) fn build(mut raw: RawMesh) -> Result<Mesh, MeshError> {
         }
     }
 
-    // Node-to-edge CSR, edges ascending in each row.
-    let mut node_edge_offsets = vec![0usize; n + 1];
-    for &[i, j] in &edges {
-        node_edge_offsets[i as usize + 1] += 1;
-        node_edge_offsets[j as usize + 1] += 1;
-    }
-    for i in 0..n {
-        node_edge_offsets[i + 1] += node_edge_offsets[i];
-    }
-    let mut fill = node_edge_offsets.clone();
-    let mut node_edges = vec![0u32; node_edge_offsets[n]];
-    for (e, &[i, j]) in edges.iter().enumerate() {
-        for v in [i, j] {
-            node_edges[fill[v as usize]] = e as u32;
-            fill[v as usize] += 1;
-        }
-    }
-
     // Boundaries: each tagged face is oriented by the cell face it matches.
     let (co, cn) = node_cells(n, &cells);
     let mut contributions: Vec<Vec<(u32, [f64; 3])>> = vec![Vec::new(); raw.patch_names.len()];
@@ -252,7 +234,7 @@ pub(super) fn build(mut raw: RawMesh) -> Result<Mesh, MeshError> {
             list.push((b, scale(cross(sub(xb, m), sub(fc, m)), 0.5)));
         }
     }
-    let boundaries = raw
+    let boundaries: Vec<Boundary> = raw
         .patch_names
         .iter()
         .zip(contributions)
@@ -273,26 +255,32 @@ pub(super) fn build(mut raw: RawMesh) -> Result<Mesh, MeshError> {
         })
         .collect();
 
+    let mut dual_areas = vec![0.0; n];
+    for (&[i, j], nu) in edges.iter().zip(&edge_normals) {
+        let a = norm(*nu);
+        dual_areas[i as usize] += a;
+        dual_areas[j as usize] += a;
+    }
+    let scale_sum = dual_areas.clone();
+    for b in &boundaries {
+        for (&i, nb) in b.nodes.iter().zip(&b.normals) {
+            dual_areas[i as usize] += norm(*nb);
+        }
+    }
     let mesh = Mesh {
         coords,
         original_ids,
         cells,
         volumes,
+        blocks: EdgeBlocks::new(n, &edges),
         edges,
         edge_normals,
-        node_edge_offsets,
-        node_edges,
+        dual_areas,
         boundaries,
     };
     // A dual cell that does not close means boundary faces are missing from every named boundary.
-    let mut scale_sum = vec![0.0f64; n];
-    for (e, &[i, j]) in mesh.edges.iter().enumerate() {
-        let a = norm(mesh.edge_normals[e]);
-        scale_sum[i as usize] += a;
-        scale_sum[j as usize] += a;
-    }
-    for i in 0..n {
-        let d = norm(mesh.closure_defect(i));
+    for (i, defect) in mesh.closure_defects().into_iter().enumerate() {
+        let d = norm(defect);
         if d > 1e-9 * scale_sum[i].max(f64::MIN_POSITIVE) {
             return Err(MeshError::OpenBoundary {
                 origin: raw.origin,

@@ -1,129 +1,145 @@
-//! Reader of gmsh `.msh` 4.1 files (ASCII or binary, through `mshio`): tets, hexes, prisms and
-//! pyramids; triangles and quads on surfaces belonging to physical groups name the boundaries
-//! (`$PhysicalNames`, read here since `mshio` skips that section).
+//! The fluid's reading of a gmsh `.msh` 4.1 mesh (format: [`interface_protocol::io::gmsh`]):
+//! linear tets, hexes, prisms and pyramids are the cells; the triangles and quads of surfaces in
+//! physical groups are the boundary faces, each physical group one boundary named by
+//! `$PhysicalNames`. A surface in several physical groups belongs to the first. Points and lines
+//! are skipped; any other element type is refused. Errors name the file and the line (and the
+//! byte offset in binary data).
 
+use super::geometry::{centroid, cross, dot, norm, sub};
 use super::{Cell, CellKind, MeshError, RawMesh, TaggedFace};
-use mshio::mshfile::ElementType;
-use std::collections::HashMap;
+use interface_protocol::io::gmsh::{self, ElementType, GmshError, Msh, Position};
 use std::path::Path;
-
-/// `(dim, tag) -> name` from the `$PhysicalNames` section.
-fn physical_names(bytes: &[u8]) -> HashMap<(i32, i32), String> {
-    let mut names = HashMap::new();
-    let text = String::from_utf8_lossy(bytes);
-    let Some(start) = text.find("$PhysicalNames") else { return names };
-    let Some(end) = text[start..].find("$EndPhysicalNames") else { return names };
-    for line in text[start..start + end].lines().skip(2) {
-        let mut parts = line.splitn(3, ' ');
-        let (Some(dim), Some(tag), Some(name)) = (parts.next(), parts.next(), parts.next()) else {
-            continue;
-        };
-        if let (Ok(dim), Ok(tag)) = (dim.trim().parse(), tag.trim().parse()) {
-            names.insert((dim, tag), name.trim().trim_matches('"').to_string());
-        }
-    }
-    names
-}
 
 /// Reads a gmsh 4.1 mesh.
 pub fn read(path: &Path) -> Result<RawMesh, MeshError> {
-    let origin = path.display().to_string();
-    let err = |msg: String| MeshError::Input(format!("{origin}: {msg}"));
-    let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read the mesh file: {e}")))?;
-    let msh = mshio::parse_msh_bytes(&bytes)
-        .map_err(|e| err(format!("not a valid gmsh 4.1 .msh file: {e}")))?;
-    let names = physical_names(&bytes);
-    let nodes =
-        msh.data.nodes.as_ref().ok_or_else(|| err("the file has no $Nodes section".into()))?;
-    let elements = msh
-        .data
-        .elements
-        .as_ref()
-        .ok_or_else(|| err("the file has no $Elements section".into()))?;
+    from_msh(gmsh::read(path, accept).map_err(input)?).map_err(input)
+}
 
-    // Node tag -> index in the concatenated blocks.
-    let mut coords = Vec::new();
-    let mut index_of: HashMap<u64, u32> = HashMap::new();
-    let dense = nodes.node_blocks.iter().all(|b| b.node_tags.is_none());
-    for b in &nodes.node_blocks {
-        let first = coords.len();
-        if let Some(tags) = &b.node_tags {
-            for (&tag, &k) in tags {
-                index_of.insert(tag, (first + k) as u32);
-            }
-        }
-        coords.extend(b.nodes.iter().map(|n| [n.x, n.y, n.z]));
-    }
-    let min_tag = nodes.min_node_tag;
-    let node = |tag: u64| -> Result<u32, MeshError> {
-        let idx = if dense {
-            tag.checked_sub(min_tag).map(|v| v as u32)
-        } else {
-            index_of.get(&tag).copied()
-        };
-        idx.filter(|&i| (i as usize) < coords.len()).ok_or_else(|| {
-            err(format!("an element refers to node tag {tag}, which is not in $Nodes"))
-        })
-    };
+fn input(e: GmshError) -> MeshError {
+    MeshError::Input(e.to_string())
+}
 
-    // Surface entity tag -> physical group name.
-    let mut surface_group: HashMap<i32, String> = HashMap::new();
-    if let Some(entities) = &msh.data.entities {
-        for s in &entities.surfaces {
-            if let Some(&pt) = s.physical_tags.first() {
-                let name = names.get(&(2, pt)).cloned().unwrap_or_else(|| format!("physical_{pt}"));
-                surface_group.insert(s.tag, name);
-            }
-        }
-    }
-    let mut patch_names: Vec<String> = Vec::new();
+/// The element types the fluid reads; the error for the others.
+fn accept(t: ElementType) -> Result<(), String> {
+    element_kind(t).map(|_| ())
+}
+
+/// What a gmsh element type is to the fluid.
+enum ElementKind {
+    Cell(CellKind),
+    Face,
+    /// A point or a line.
+    Skipped,
+}
+
+fn element_kind(t: ElementType) -> Result<ElementKind, String> {
+    Ok(match t.code {
+        4 => ElementKind::Cell(CellKind::Tet),
+        5 => ElementKind::Cell(CellKind::Hex),
+        6 => ElementKind::Cell(CellKind::Prism),
+        7 => ElementKind::Cell(CellKind::Pyramid),
+        2 | 3 => ElementKind::Face,
+        15 | 1 => ElementKind::Skipped,
+        _ => return Err(format!(
+            "element type {} ({t}) is not supported: linear tetrahedra (4), hexahedra (5), prisms (6) and pyramids (7), with triangles (2) and quadrangles (3) on the boundary",
+            t.code
+        )),
+    })
+}
+
+/// The cells, the named boundary faces and the boundary names of `msh`.
+fn from_msh(msh: Msh) -> Result<RawMesh, GmshError> {
     let mut cells = Vec::new();
     let mut faces = Vec::new();
-    for block in &elements.element_blocks {
-        let kind = match block.element_type {
-            ElementType::Tet4 => Some(CellKind::Tet),
-            ElementType::Hex8 => Some(CellKind::Hex),
-            ElementType::Pri6 => Some(CellKind::Prism),
-            ElementType::Pyr5 => Some(CellKind::Pyramid),
-            ElementType::Tri3 | ElementType::Qua4 => None,
-            ElementType::Pnt | ElementType::Lin2 => continue,
-            other => {
-                return Err(err(format!(
-                    "element type {other:?} is not supported (linear tets, hexes, prisms, pyramids, triangles and quads only)"
-                )))
-            }
-        };
+    let mut patch_names: Vec<String> = Vec::new();
+    for block in &msh.blocks {
+        let kind = element_kind(block.kind).map_err(|m| msh.error(block.at, m))?;
         match kind {
-            Some(kind) => {
-                for e in &block.elements {
-                    let ids: Vec<u32> =
-                        e.nodes.iter().map(|&t| node(t)).collect::<Result<_, _>>()?;
-                    cells.push(Cell::new(kind, &ids));
+            ElementKind::Cell(k) => {
+                for (ids, (&tag, &at)) in
+                    block.elements().zip(block.tags.iter().zip(&block.positions))
+                {
+                    let volume = signed_volume(k, ids, &msh.coords);
+                    let size = ids
+                        .iter()
+                        .map(|&i| norm(sub(msh.coords[i as usize], msh.coords[ids[0] as usize])))
+                        .fold(0.0, f64::max);
+                    if volume.partial_cmp(&(1e-12 * size * size * size)).is_none_or(|o| o.is_le()) {
+                        return Err(msh.error(at, format!(
+                            "element {tag} ({}) is inverted or flat (signed volume {volume:e}): its nodes must follow gmsh's ordering with a positive orientation",
+                            k.name()
+                        )));
+                    }
+                    cells.push(Cell::new(k, ids));
                 }
             }
-            None => {
-                // Faces of surfaces without a physical group are ignored; if they bound the
-                // domain, Mesh::build reports the open dual cells there.
-                let Some(name) = surface_group.get(&block.entity_tag) else { continue };
-                let patch = match patch_names.iter().position(|n| n == name) {
+            ElementKind::Face => {
+                let Some(name) = surface_name(&msh, block.entity, block.at)? else { continue };
+                let patch = match patch_names.iter().position(|p| *p == name) {
                     Some(p) => p,
                     None => {
-                        patch_names.push(name.clone());
+                        patch_names.push(name);
                         patch_names.len() - 1
                     }
-                } as u32;
-                for e in &block.elements {
-                    let ids: Vec<u32> =
-                        e.nodes.iter().map(|&t| node(t)).collect::<Result<_, _>>()?;
-                    faces.push(TaggedFace { patch, nodes: ids });
-                }
+                };
+                faces.extend(
+                    block
+                        .elements()
+                        .map(|ids| TaggedFace { patch: patch as u32, nodes: ids.to_vec() }),
+                );
             }
+            ElementKind::Skipped => {}
         }
     }
     if cells.is_empty() {
         return Err(
-            err("the file has no volume elements (tets, hexes, prisms or pyramids)".into()),
+            msh.error(msh.end, "the file has no volume elements (tets, hexes, prisms or pyramids)")
         );
     }
-    Ok(RawMesh { coords, cells, faces, patch_names, origin })
+    Ok(RawMesh { coords: msh.coords, cells, faces, patch_names, origin: msh.origin })
+}
+
+/// The boundary name of the faces of surface `entity` (block at `block`), or `None` if it is in
+/// no physical group (its faces are then dropped; if they bound the domain, `Mesh::build`
+/// reports the dual cells left open there).
+fn surface_name(msh: &Msh, entity: i32, block: Position) -> Result<Option<String>, GmshError> {
+    let Some(entities) = &msh.entities else {
+        return Err(msh.error(
+            block,
+            "surface elements, but no `$Entities` section to give their physical groups",
+        ));
+    };
+    let Some(surface) = entities.get(&(2, entity)) else {
+        return Err(msh.error(block, format!("surface {entity} is not in `$Entities`")));
+    };
+    let Some(&group) = surface.physical.first() else { return Ok(None) };
+    if msh.physical_names.is_none() {
+        return Err(msh.error(
+            surface.at,
+            format!("surface {entity} is in physical group {group}, but the file has no `$PhysicalNames` section: name each boundary with a named physical surface group"),
+        ));
+    }
+    match msh.physical_name(2, group) {
+        Some(name) => Ok(Some(name.to_string())),
+        None => Err(msh.error(
+            surface.at,
+            format!("surface {entity} is in physical group {group}, which `$PhysicalNames` does not name"),
+        )),
+    }
+}
+
+/// Signed volume of a cell: cones from its centroid over the triangles joining each outward face
+/// (gmsh ordering, [`CellKind::faces`]) to the face centroid. Negative for an inverted cell.
+fn signed_volume(kind: CellKind, ids: &[u32], coords: &[[f64; 3]]) -> f64 {
+    let x = |l: usize| coords[ids[l] as usize];
+    let g = centroid((0..kind.n_nodes()).map(x));
+    let mut v = 0.0;
+    for face in kind.faces() {
+        let fc = centroid(face.iter().map(|&l| x(l)));
+        for q in 0..face.len() {
+            let (a, b) = (sub(x(face[q]), g), sub(x(face[(q + 1) % face.len()]), g));
+            v += dot(cross(a, b), sub(fc, g)) / 6.0;
+        }
+    }
+    v
 }

@@ -42,11 +42,14 @@ impl Limiter {
                 }
             }
             Limiter::VanAlbada => {
+                // Evaluated before the test so that the edge loop can compute several slopes at
+                // once in SIMD registers (the quotient is discarded where ab <= 0).
                 let ab = a * b;
+                let r = ab * (a + b) / (a * a + b * b);
                 if ab <= 0.0 {
                     0.0
                 } else {
-                    ab * (a + b) / (a * a + b * b)
+                    r
                 }
             }
         }

@@ -11,9 +11,20 @@ use crate::eos::Eos;
 #[inline(always)]
 pub fn extrapolate(limiter: Limiter, ui: f64, uj: f64, gi_d: f64, gj_d: f64) -> (f64, f64) {
     let delta = uj - ui;
-    let li = limiter.slope(2.0 * gi_d - delta, delta);
-    let lj = limiter.slope(2.0 * gj_d - delta, delta);
-    (ui + 0.5 * li, uj - 0.5 * lj)
+    let s = slopes(limiter, [gi_d, gj_d], [delta, delta]);
+    (ui + 0.5 * s[0], uj - 0.5 * s[1])
+}
+
+/// The limited slopes `L(2 g_m - Δ_m, Δ_m)` of `M` scalars side by side (so that the compiler
+/// evaluates them in SIMD registers), from the gradient projections `g_m` and the differences
+/// `Δ_m` along the edge.
+#[inline(always)]
+fn slopes<const M: usize>(limiter: Limiter, g_d: [f64; M], delta: [f64; M]) -> [f64; M] {
+    let mut s = [0.0; M];
+    for m in 0..M {
+        s[m] = limiter.slope(2.0 * g_d[m] - delta[m], delta[m]);
+    }
+    s
 }
 
 /// Midpoint primitive states `(W_ij, W_ji)` of an edge from the nodal primitive states, their
@@ -37,10 +48,18 @@ pub fn reconstruct(
         return (*wi, *wj);
     }
     let dot = |g: &[f64; 3]| g[0] * d[0] + g[1] * d[1] + g[2] * d[2];
+    // Both ends' slopes of all five variables at once.
+    let mut g_d = [0.0; 10];
+    let mut delta = [0.0; 10];
+    for k in 0..5 {
+        (g_d[k], g_d[5 + k]) = (dot(&grad_i[k]), dot(&grad_j[k]));
+        (delta[k], delta[5 + k]) = (wj[k] - wi[k], wj[k] - wi[k]);
+    }
+    let s = slopes(limiter, g_d, delta);
     let mut wij = [0.0; 5];
     let mut wji = [0.0; 5];
     for k in 0..5 {
-        (wij[k], wji[k]) = extrapolate(limiter, wi[k], wj[k], dot(&grad_i[k]), dot(&grad_j[k]));
+        (wij[k], wji[k]) = (wi[k] + 0.5 * s[k], wj[k] - 0.5 * s[5 + k]);
     }
     if eos_i.is_barotropic() {
         wij[4] = eos_i.tait_pressure(wij[0]);

@@ -4,10 +4,11 @@
 use super::cfl::{stable_time_step, TimeStepping};
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::state::{State, Workspace};
-use rayon::prelude::*;
 
 /// Advances `state` by one RK2 step no longer than `dt_max`; returns the (global) step taken
-/// (for local stepping, the smallest node step).
+/// (for local stepping, the smallest node step). Each stage's update is applied inside the
+/// residual's edge pass ([`Semidiscretization::residual_and_update`]); the new state is built in
+/// `ws.stage` and swapped in at the end, so on error `state` is unchanged.
 pub fn rk2_step(
     semi: &Semidiscretization,
     state: &mut State,
@@ -19,39 +20,37 @@ pub fn rk2_step(
     let dt_global = (stepping.cfl() * dt_min).min(dt_max);
     let local = matches!(stepping, TimeStepping::Local { .. });
     let cfl = stepping.cfl();
-    if local {
-        ws.dt_node.par_iter_mut().for_each(|dt| *dt = (cfl * *dt).min(dt_max));
-    }
     let volumes = &semi.mesh.volumes;
-    let dt_of = |dt_node: &[f64], i: usize| if local { dt_node[i] } else { dt_global };
-
-    // Stage 1.
-    semi.residual_from_primitives(ws)?;
     let mut stage = std::mem::take(&mut ws.stage);
-    {
-        let (res, dtn) = (&ws.residual, &ws.dt_node);
-        stage.par_iter_mut().enumerate().with_min_len(1024).for_each(|(i, w1)| {
-            let a = dt_of(dtn, i) / volumes[i];
-            for k in 0..5 {
-                w1[k] = state.cons[i][k] - a * res[i][k];
-            }
+    let dt_node = std::mem::take(&mut ws.dt_node);
+    // Δt_i / |C_i|.
+    let ratio = |i: usize| {
+        let dt = if local { (cfl * dt_node[i]).min(dt_max) } else { dt_global };
+        dt / volumes[i]
+    };
+    let cons = &state.cons;
+    // Stage 1: W¹ = Wⁿ - Δt/|C| R(Wⁿ), into `stage`.
+    let mut result = semi.residual_and_update(ws, &mut stage, |i, r, w1| {
+        let a = ratio(i);
+        for k in 0..5 {
+            w1[k] = cons[i][k] - a * r[k];
+        }
+    });
+    // Stage 2: Wⁿ⁺¹ = ½ Wⁿ + ½ (W¹ - Δt/|C| R(W¹)), in place of W¹ in `stage`.
+    if result.is_ok() {
+        result = semi.primitives(&stage, ws).and_then(|()| {
+            semi.residual_and_update(ws, &mut stage, |i, r, w| {
+                let a = ratio(i);
+                for k in 0..5 {
+                    w[k] = 0.5 * cons[i][k] + 0.5 * (w[k] - a * r[k]);
+                }
+            })
         });
     }
-    // Stage 2.
-    let r = semi.residual(&stage, ws);
-    if let Err(e) = r {
-        ws.stage = stage;
-        return Err(e);
-    }
-    {
-        let (res, dtn) = (&ws.residual, &ws.dt_node);
-        state.cons.par_iter_mut().enumerate().with_min_len(1024).for_each(|(i, w)| {
-            let a = dt_of(dtn, i) / volumes[i];
-            for k in 0..5 {
-                w[k] = 0.5 * w[k] + 0.5 * (stage[i][k] - a * res[i][k]);
-            }
-        });
+    if result.is_ok() {
+        std::mem::swap(&mut state.cons, &mut stage);
     }
     ws.stage = stage;
-    Ok(dt_global)
+    ws.dt_node = dt_node;
+    result.map(|()| dt_global)
 }

@@ -51,6 +51,7 @@
 pub mod atomic;
 pub mod checkpoint;
 pub mod finite;
+pub mod gmsh;
 pub mod outdir;
 pub mod probes;
 pub mod progress;
