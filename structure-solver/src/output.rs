@@ -2,11 +2,12 @@
 //! of nodal displacement and velocity on the mesh (one cell block per cell kind), each step
 //! checked for the first non-finite value first (the stop names the field, node and time).
 //!
-//! Cell fields ([`cell_fields`]): the largest equivalent plastic strain through the thickness
-//! of J2 shells and BT4 shells (tets: at their point), and the largest von Mises stress
-//! through the thickness of BT4 shells (0 on other cells); an elastic model without BT4 shells
-//! has nodal fields only. `structure_cells.csv` holds the final cell fields with the cell
-//! centroids.
+//! Cell fields ([`cell_fields`]): the von Mises stress of every element (`Element::von_mises`:
+//! shells the largest through the thickness, beams the largest corner stress, tets from the
+//! Cauchy stress; BT4 shells the largest over their thickness points), and the largest
+//! equivalent plastic strain through the thickness of J2 shells and BT4 shells (tets: at their
+//! point) when the model has plastic states. `structure_cells.csv` holds the final cell fields
+//! with the cell centroids.
 
 use std::io::Write;
 use std::path::Path;
@@ -18,6 +19,7 @@ use interface_protocol::io::xdmf::{
 };
 
 use crate::assembly::FeModel;
+use crate::elements::layered::shell_von_mises;
 use crate::elements::ElementKind;
 use crate::mesh::{CellKind, Mesh};
 use crate::model::Model;
@@ -31,14 +33,9 @@ pub struct CellMap {
     pub n_cells: usize,
 }
 
-/// Von Mises stress of a shell point `[σxx, σyy, σxy, σyz, σzx]` (σzz = 0).
-fn von_mises(s: [f64; 5]) -> f64 {
-    let [xx, yy, xy, yz, zx] = s;
-    (xx * xx - xx * yy + yy * yy + 3.0 * (xy * xy + yz * yz + zx * zx)).sqrt()
-}
-
-/// The committed cell fields of `model`, one value per mesh cell: `plastic_strain` when some
-/// element has a J2 state or the model has BT4 shells, `von_mises` when it has BT4 shells.
+/// The committed cell fields of `model`, one value per mesh cell: `von_mises` of every element
+/// (`Element::von_mises`; BT4 shells the largest over their thickness points), and
+/// `plastic_strain` when some element has a J2 state or the model has BT4 shells.
 pub fn cell_fields(model: &FeModel, map: &CellMap) -> Vec<(&'static str, Vec<f64>)> {
     let n = map.n_cells;
     let bt4 = model.bt4();
@@ -64,14 +61,20 @@ pub fn cell_fields(model: &FeModel, map: &CellMap) -> Vec<(&'static str, Vec<f64
         }
         out.push(("plastic_strain", ep));
     }
+    let mut vm = vec![0.0; n];
+    let (x, r) = (model.positions(), model.rotations());
+    for (e, (el, &c)) in model.elements().iter().zip(&map.elements).enumerate() {
+        let xe: Vec<_> = el.nodes.iter().map(|&i| x[i]).collect();
+        let re: Vec<_> = el.nodes.iter().map(|&i| r[i]).collect();
+        vm[c] = el.von_mises(&xe, &re, model.element_state(e));
+    }
     if let Some(b) = bt4 {
         let np = b.settings.rule.len();
-        let mut vm = vec![0.0; n];
         for (e, &c) in map.bt4.iter().enumerate() {
-            vm[c] = (0..np).map(|p| von_mises(b.stress(e, p))).fold(0.0, f64::max);
+            vm[c] = (0..np).map(|p| shell_von_mises(&b.stress(e, p))).fold(0.0, f64::max);
         }
-        out.push(("von_mises", vm));
     }
+    out.push(("von_mises", vm));
     out
 }
 

@@ -36,6 +36,7 @@ enum Body {
     Corotated {
         reference: Reference,
         k: DMatrix<f64>,
+        stress: ElasticStress,
     },
     /// Corotated shell of a J2 material integrated through the thickness.
     Layered {
@@ -43,6 +44,15 @@ enum Body {
         shell: Box<LayeredJ2>,
     },
     Tet(Tet4),
+}
+
+/// What the stress of an elastic corotated element is read from.
+#[derive(Debug, Clone)]
+enum ElasticStress {
+    /// Shell: the in-plane points and the section.
+    Shell { layers: Box<Layers>, sec: ShellSection },
+    /// Beam: the section (end forces come from `K d`).
+    Beam(BeamSection),
 }
 
 /// One finite element.
@@ -107,7 +117,11 @@ impl Element {
         let i = sec.rho * sec.h.powi(3) / 12.0 * area / n;
         let mass = (0..nodes.len()).flat_map(|_| [m, m, m, i, i, i]).collect();
         let body = match yield_ {
-            None => Body::Corotated { k: layers.elastic_stiffness(sec), reference },
+            None => Body::Corotated {
+                k: layers.elastic_stiffness(sec),
+                reference,
+                stress: ElasticStress::Shell { layers: Box::new(layers), sec: *sec },
+            },
             Some(y) => {
                 let material = J2 {
                     elastic: Elastic { e: sec.e, nu: sec.nu, rho: sec.rho },
@@ -146,7 +160,7 @@ impl Element {
         Element {
             kind: ElementKind::Beam2,
             nodes: nodes.to_vec(),
-            body: Body::Corotated { reference, k },
+            body: Body::Corotated { reference, k, stress: ElasticStress::Beam(*sec) },
             mass,
             measure: l,
         }
@@ -194,7 +208,7 @@ impl Element {
         let mut d = [0.0; 24];
         let nd = 6 * x.len();
         match &self.body {
-            Body::Corotated { reference, k } => {
+            Body::Corotated { reference, k, .. } => {
                 // fl = K d as a sum of contiguous columns of K (column-major storage)
                 let local = |d: &[f64], fl: &mut [f64]| {
                     fl.fill(0.0);
@@ -236,6 +250,47 @@ impl Element {
         }
     }
 
+    /// Largest von Mises stress of the element at nodal positions `x` and rotations `r` with
+    /// the committed material `state`: shells, the largest over the in-plane points and the
+    /// thickness points (J2, `LayeredJ2::von_mises`) or the bottom, mid and top surfaces
+    /// (elastic, `Layers::von_mises`), in-plane stresses only; beams, the largest axial plus
+    /// bending stress `|N|/A + |M_y| c_z/I_y + |M_z| c_y/I_z` at the two ends, `c` the corner
+    /// distances of the rectangle with the section's `A`, `I_y`, `I_z` (exact for rectangular
+    /// sections; torsion left out); tets, of the Cauchy stress (`Tet4::von_mises`).
+    pub fn von_mises(&self, x: &[Vector3<f64>], r: &[Matrix3<f64>], state: &[f64]) -> f64 {
+        let local = || self.deformation(x, r).unwrap_or_default();
+        match &self.body {
+            Body::Corotated { stress: ElasticStress::Shell { layers, sec }, .. } => {
+                layers.von_mises(&local(), sec)
+            }
+            Body::Corotated { stress: ElasticStress::Beam(sec), k, .. } => {
+                if sec.area <= 0.0 {
+                    return 0.0;
+                }
+                let fl = k * nalgebra::DVector::from_vec(local());
+                // |M| c / I with c the half-width of the equivalent rectangle (c² = 3 I / A)
+                let bending = |m: f64, i: f64| {
+                    if i > 0.0 {
+                        m.abs() * (3.0 * i / sec.area).sqrt() / i
+                    } else {
+                        0.0
+                    }
+                };
+                let axial = fl[6].abs() / sec.area;
+                [0, 6]
+                    .map(|o| axial + bending(fl[o + 4], sec.iy) + bending(fl[o + 5], sec.iz))
+                    .into_iter()
+                    .fold(0.0, f64::max)
+            }
+            Body::Layered { shell, .. } => shell.von_mises(&local(), state),
+            Body::Tet(t) => {
+                let xs = [x[0], x[1], x[2], x[3]];
+                let st = J2State3d { eps_p: std::array::from_fn(|i| state[i]), alpha: state[6] };
+                t.von_mises(&xs, &st)
+            }
+        }
+    }
+
     /// Tangent `∂f/∂q` (with `extra`, a configuration-dependent load term `-f_ext`
     /// differentiated with it). Corotated shells and beams: the consistent tangent
     /// `Bᵀ K_l B + K_G` of `Reference::tangent`, `K_l` the elastic stiffness or the algorithmic
@@ -251,7 +306,7 @@ impl Element {
         let size = 6 * x.len();
         let (reference, fl, kl, d, b, fr) = match &self.body {
             Body::Tet(_) => return self.tangent_by_differences(x, r, state, extra),
-            Body::Corotated { reference, k } => {
+            Body::Corotated { reference, k, .. } => {
                 let mut d = vec![0.0; size];
                 let mut b = DMatrix::zeros(size, size);
                 let fr = reference.deformation(x, r, &mut d, Some(&mut b));

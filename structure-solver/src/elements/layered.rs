@@ -48,6 +48,40 @@ impl Layers {
     }
 }
 
+/// Von Mises stress of a shell point `[σxx, σyy, σxy]` or `[σxx, σyy, σxy, σyz, σzx]`
+/// (σzz = 0), scaled by the largest component against overflow (a diverging run then stops at
+/// its first non-finite nodal value, not at a squared stress).
+pub fn shell_von_mises(s: &[f64]) -> f64 {
+    let scale = s.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return scale;
+    }
+    let (xx, yy) = (s[0] / scale, s[1] / scale);
+    let shear: f64 = s[2..].iter().map(|v| (v / scale).powi(2)).sum();
+    scale * (xx * xx - xx * yy + yy * yy + 3.0 * shear).sqrt()
+}
+
+impl Layers {
+    /// Largest in-plane von Mises stress of an elastic section at local deformational
+    /// displacements `d`: `σ = C (ε_m + z κ)` at the bottom, mid and top surfaces
+    /// (`z = -h/2, 0, h/2`) of every in-plane point.
+    pub fn von_mises(&self, d: &[f64], sec: &ShellSection) -> f64 {
+        let c = sec.membrane().map(|r| r.map(|v| v / sec.h));
+        let dv = nalgebra::DVectorView::from_slice(d, d.len());
+        let mut vm = 0.0_f64;
+        for p in &self.points {
+            let (em, kap) = (&p.bm * dv, &p.bb * dv);
+            for z in [-0.5 * sec.h, 0.0, 0.5 * sec.h] {
+                let eps: [f64; 3] = std::array::from_fn(|k| em[k] + z * kap[k]);
+                let sigma: [f64; 3] =
+                    std::array::from_fn(|i| (0..3).map(|j| c[i][j] * eps[j]).sum());
+                vm = vm.max(shell_von_mises(&sigma));
+            }
+        }
+        vm
+    }
+}
+
 /// A shell element of a J2 material integrated through the thickness.
 #[derive(Debug, Clone)]
 pub struct LayeredJ2 {
@@ -62,6 +96,30 @@ impl LayeredJ2 {
     /// Length of the element's state array.
     pub fn n_state(&self) -> usize {
         self.layers.points.len() * self.rule.len() * POINT_STATE
+    }
+
+    /// Largest in-plane von Mises stress over the in-plane and thickness points at local
+    /// deformational displacements `d` with the committed `state` (the stress of the
+    /// plane-stress return, as `force` computes it).
+    pub fn von_mises(&self, d: &[f64], state: &[f64]) -> f64 {
+        let dv = nalgebra::DVectorView::from_slice(d, d.len());
+        let nt = self.rule.len();
+        let mut vm = 0.0_f64;
+        for (g, p) in self.layers.points.iter().enumerate() {
+            let (em, kap) = (&p.bm * dv, &p.bb * dv);
+            for (t, &zeta) in self.rule.points.iter().enumerate() {
+                let z = 0.5 * self.h * zeta;
+                let eps = [em[0] + z * kap[0], em[1] + z * kap[1], em[2] + z * kap[2]];
+                let i = (g * nt + t) * POINT_STATE;
+                let s0 = J2StatePlane {
+                    eps_p: [state[i], state[i + 1], state[i + 2]],
+                    alpha: state[i + 3],
+                };
+                let (sigma, _, _) = self.material.update_plane_stress(&eps, &s0);
+                vm = vm.max(shell_von_mises(&sigma));
+            }
+        }
+        vm
     }
 
     /// Local force `fl` at local deformational displacements `d` from the committed state

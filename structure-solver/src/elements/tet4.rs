@@ -50,6 +50,22 @@ impl Tet4 {
         (m, trial)
     }
 
+    /// Von Mises stress of the Cauchy stress `σ = F S Fᵀ / det F` at current positions `x`
+    /// with the committed `state`.
+    pub fn von_mises(&self, x: &[Vector3<f64>; 4], state: &J2State3d) -> f64 {
+        let f = self.deformation_gradient(x);
+        let (s, _) = self.pk2(&f, state);
+        let sigma = f * s * f.transpose() / f.determinant();
+        let dev = sigma - Matrix3::identity() * (sigma.trace() / 3.0);
+        // scaled by the largest component against overflow
+        let scale = dev.amax();
+        if scale == 0.0 || !scale.is_finite() {
+            return scale;
+        }
+        let n = dev / scale;
+        scale * (1.5 * n.component_mul(&n).sum()).sqrt()
+    }
+
     /// Nodal internal forces `f_a = V0 F S ∇N_a` and the trial material state.
     pub fn force(
         &self,
