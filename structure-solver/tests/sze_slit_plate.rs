@@ -1,9 +1,9 @@
 //! Sze, Liu & Lo (2004, Finite Elem. Anal. Des. 40:1551), slit annular plate under a line
 //! force. Inner radius 6, outer radius 10, h = 0.03, E = 21e6, ν = 0; clamped along one side
 //! of the slit, a transverse line force q = 0.8 per unit length (q_max) along the other.
-//! Mesh: 10 (radial) x 80 (circumferential) 4-node shells, the paper's S4R mesh, and the same
-//! mesh split into triangles. Reference: the paper's table (W_A at the inner radius, W_B at the
-//! outer, on the loaded side), as committed in MBDyn's test suite
+//! Mesh: 10 (radial) x 80 (circumferential) 4-node shells, the paper's S4R mesh, and a mesh
+//! twice as fine split into triangles (flat triangles lock here). Reference: the paper's table
+//! (W_A at the inner radius, W_B at the outer, on the loaded side), as committed in MBDyn's test suite
 //! (tests/plates/sze2004/sze33/sze33_ref.dat, "mesh: 10x80; 6x30 quite similar").
 
 mod common;
@@ -69,14 +69,15 @@ fn quads_10x80_follow_the_reference() {
     );
 }
 
-/// The constant-strain membrane of the flat triangle is stiffer (-2.6% at q_max on the same
-/// mesh), held to 3%.
+/// Flat triangles with a constant-strain membrane lock on the twisted surface: on the paper's
+/// mesh split in two they are 2.6% stiff at q_max (W_A), so, as for the hemisphere, they run
+/// on a mesh twice as fine (DESIGN §8), where they are within about 1.1%.
 #[test]
 #[cfg_attr(debug_assertions, ignore = "benchmark of several seconds: run with --release")]
-fn triangles_10x80_follow_the_reference() {
+fn triangles_20x160_follow_the_reference() {
     run(
-        generate::annulus(6.0, 10.0, [0.0, 2.0 * std::f64::consts::PI], 80, 10).to_triangles(),
-        "slit plate triangles 10x80x2",
-        0.03,
+        generate::annulus(6.0, 10.0, [0.0, 2.0 * std::f64::consts::PI], 160, 20).to_triangles(),
+        "slit plate triangles 20x160x2",
+        0.015,
     );
 }
