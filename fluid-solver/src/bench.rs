@@ -128,7 +128,7 @@ pub fn run(
     for &threads in threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let m = pool.install(|| -> anyhow::Result<Measurement> {
-            let mut ws = Workspace::new(n_nodes, semi.mesh.n_edges());
+            let mut ws = Workspace::new(n_nodes);
             let mut state = initial.clone();
             let stepping = TimeStepping::Global { cfl: 0.9 };
             // Warm up, then time each step.

@@ -131,7 +131,7 @@ impl<'a> FluidRun<'a> {
             Some(dir) => read_checkpoint(dir, semi.mesh.n_nodes())?,
             None => (initial, 0, 0.0),
         };
-        let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+        let mut ws = Workspace::new(semi.mesh.n_nodes());
         semi.primitives(&state.cons, &mut ws)?;
 
         let mut fields = output::create_writer(out.path(), &semi.mesh)?;

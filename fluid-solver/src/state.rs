@@ -42,9 +42,8 @@ pub struct Workspace {
 }
 
 impl Workspace {
-    /// The scratch arrays of a mesh of `n_nodes` nodes; `_n_edges` sizes nothing (no array is
-    /// per edge) and is kept so the callers need not change when one is.
-    pub fn new(n_nodes: usize, _n_edges: usize) -> Workspace {
+    /// The scratch arrays of a mesh of `n_nodes` nodes (no array is per edge).
+    pub fn new(n_nodes: usize) -> Workspace {
         Workspace {
             prim: vec![[0.0; 5]; n_nodes],
             grad: vec![[[0.0; 3]; 5]; n_nodes],

@@ -209,7 +209,7 @@ fn each_named_group_carries_its_own_boundary_condition() {
             let numerics = Numerics { flux: FluxScheme::Roe, limiter: Limiter::VanAlbada };
             let semi = Semidiscretization::new(mesh.clone(), GAS, numerics, &conditions).unwrap();
             let state = InitialCondition::uniform(rest).state(&semi.mesh, &GAS).unwrap();
-            let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+            let mut ws = Workspace::new(semi.mesh.n_nodes());
             semi.residual(&state.cons, &mut ws).unwrap();
             let moved: Vec<u32> = (0..semi.mesh.n_nodes() as u32)
                 .filter(|&i| ws.residual[i as usize].iter().any(|r| r.abs() > 1e-12))
@@ -244,7 +244,7 @@ fn free_stream_is_preserved_on_gmsh_meshes() {
             let semi = Semidiscretization::new(mesh.clone(), GAS, numerics, &conditions).unwrap();
             let mut state = InitialCondition::uniform(w).state(&semi.mesh, &GAS).unwrap();
             let initial = state.clone();
-            let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+            let mut ws = Workspace::new(semi.mesh.n_nodes());
             for _ in 0..5 {
                 let dt =
                     rk2_step(&semi, &mut state, &mut ws, TimeStepping::Global { cfl: 0.9 }, 1.0)

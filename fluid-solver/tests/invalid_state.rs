@@ -71,7 +71,7 @@ fn stops_naming_node_time_and_values(out: &Path, overrides: &[String]) -> (Strin
     let semi = &problem.semi;
     let (mut state, at_step, at_time) = read_checkpoint(out, semi.mesh.n_nodes()).unwrap();
     assert_eq!((at_step + 1, at_time.to_bits()), (step, time.to_bits()), "{msg}");
-    let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+    let mut ws = Workspace::new(semi.mesh.n_nodes());
     let replay = rk2_step(semi, &mut state, &mut ws, problem.stepping, problem.t_end - at_time)
         .expect_err("the replayed step fails");
     let FluidError::InvalidState { node: n, position: x, prim, error } = replay else {
@@ -120,7 +120,7 @@ fn non_positive_density_is_reported_with_its_node_and_values() {
     let mut state = problem.initial.clone();
     let node = semi.mesh.n_nodes() / 3;
     state.cons[node][0] = -0.25;
-    let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+    let mut ws = Workspace::new(semi.mesh.n_nodes());
     let e = rk2_step(semi, &mut state, &mut ws, problem.stepping, 1.0).unwrap_err();
     let msg = e.to_string();
     println!("{msg}");

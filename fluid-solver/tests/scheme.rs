@@ -74,7 +74,7 @@ fn residuals_sum_to_the_boundary_flux() {
     let semi = Semidiscretization::new(mesh, GAS, Numerics::default(), &bcs).unwrap();
     let state =
         State { cons: semi.mesh.coords.iter().map(|&x| GAS.prim_to_cons(&wavy(x))).collect() };
-    let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+    let mut ws = Workspace::new(semi.mesh.n_nodes());
     semi.residual(&state.cons, &mut ws).unwrap();
     let boundary = semi.boundary_flux_total(&ws.prim).unwrap();
     for k in 0..5 {
@@ -99,7 +99,7 @@ fn five_steps(threads: usize) -> Vec<[f64; 5]> {
         assert!(semi.mesh.blocks.len() >= 6, "{} edge blocks", semi.mesh.blocks.len());
         let mut state =
             State { cons: semi.mesh.coords.iter().map(|&x| GAS.prim_to_cons(&wavy(x))).collect() };
-        let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+        let mut ws = Workspace::new(semi.mesh.n_nodes());
         for _ in 0..5 {
             rk2_step(&semi, &mut state, &mut ws, TimeStepping::Global { cfl: 0.9 }, 1.0).unwrap();
         }
@@ -190,7 +190,7 @@ fn local_time_stepping_reaches_the_uniform_channel_flow() {
             })
             .collect(),
     };
-    let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+    let mut ws = Workspace::new(semi.mesh.n_nodes());
     for _ in 0..STEADY_STEPS {
         rk2_step(&semi, &mut state, &mut ws, TimeStepping::Local { cfl: 0.9 }, f64::INFINITY)
             .unwrap();

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 
 /// Marches `state` to `t_end` with RK2 at the given CFL; returns the number of steps.
 pub fn march(semi: &Semidiscretization, state: &mut State, t_end: f64, cfl: f64) -> usize {
-    let mut ws = Workspace::new(semi.mesh.n_nodes(), semi.mesh.n_edges());
+    let mut ws = Workspace::new(semi.mesh.n_nodes());
     let mut t = 0.0;
     let mut steps = 0;
     while t < t_end * (1.0 - 1e-12) {

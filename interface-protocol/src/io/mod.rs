@@ -11,6 +11,8 @@
 //! - [`progress`]: the terminal progress bar (step, time, dt, steps/s, ETA).
 //! - [`report`]: `run.json` (case echo, versions, counts, wall-time buckets) and the
 //!   [`report::Timers`] that fill it.
+//! - [`gmsh`]: the gmsh `.msh` 4.1 reader (ASCII and binary) both solvers build their meshes
+//!   on, with errors naming the file and line.
 //!
 //! Every file a reader may open while the run goes on (`*.xdmf`, `run.json`, checkpoints, line
 //! samples) is written to a temporary name and renamed into place ([`atomic`]), so a crash leaves
