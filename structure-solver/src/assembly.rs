@@ -2,10 +2,11 @@
 //!
 //! Six dofs per node `[ux, uy, uz, θx, θy, θz]`; rotations are stored as matrices and updated
 //! by spatial spins, `R ← exp([δθ]×) R`. Constraints: fixed dofs, symmetry planes normal to a
-//! global axis (`u·n = 0`, rotation only about `n`), prescribed translations and rotations
-//! over time (a prescribed rotation dof accumulates its spins). Loads: point loads, gravity,
-//! follower pressure on shells and an external nodal array filled by the coupling. Each load
-//! scales with a `Curve` of time; static solves use `t` as the load factor.
+//! global axis (`u·n = 0`, rotation only about `n`) or to any vector (`symmetry_plane`: a
+//! linear constraint per node, reduced like the rigid bodies), prescribed translations and
+//! rotations over time (a prescribed rotation dof accumulates its spins). Loads: point loads,
+//! gravity, follower pressure on shells and an external nodal array filled by the coupling.
+//! Each load scales with a `Curve` of time; static solves use `t` as the load factor.
 //!
 //! Rigid bodies and links (`rigid`): slave nodes follow a master node; the model then returns
 //! reduced forces `Tᵀ f` and tangent `Tᵀ K T` (plus the geometric term of the rotating
@@ -90,6 +91,114 @@ pub enum AssemblyError {
     NodeRange { node: usize, n: usize },
     #[error("cell {cell}: BT4 shells of one model share one material and thickness rule")]
     Bt4Material { cell: usize },
+    #[error("symmetry plane: the normal {normal:?} is not a finite non-zero vector")]
+    BadNormal { normal: [f64; 3] },
+    #[error("symmetry plane: node {node} belongs to a rigid body")]
+    SymmetryRigid { node: usize },
+    #[error("symmetry plane: node {node} has a prescribed dof")]
+    SymmetryPrescribed { node: usize },
+}
+
+/// The linear constraints of skew symmetry planes at one node (`FeModel::symmetry_plane`):
+/// each plane of normal `n` asks `u·n = 0` and `θ·a = θ·b = 0` (`a`, `b` spanning the plane),
+/// fixed dofs ask their component to vanish. Gauss-Jordan elimination of these rows picks
+/// dependent dofs (pivots) and writes the node's dofs as `u = T q`, `q` its independent dofs
+/// (the node's own global components, so velocities and loads keep their meaning): the
+/// reduction `Tᵀ f`, `Tᵀ K T`, `Tᵀ M T` of the rigid bodies, per node.
+#[derive(Debug, Clone)]
+struct SkewNode {
+    node: usize,
+    normals: Vec<Vector3<f64>>,
+    /// The node's constrained flags before its first plane.
+    base: [bool; 6],
+    /// `T` (6x6, node dofs); columns of dependent dofs are zero.
+    t: nalgebra::Matrix6<f64>,
+    dependent: [bool; 6],
+}
+
+impl SkewNode {
+    /// Eliminates the constraint rows of one 3-vector block (translations or rotations):
+    /// returns the block of `T` and the dependent components.
+    fn eliminate(rows: &[Vector3<f64>]) -> (Matrix3<f64>, [bool; 3]) {
+        let mut a: Vec<Vector3<f64>> = rows.iter().map(|r| r / r.norm()).collect();
+        let mut pivots: Vec<(usize, usize)> = Vec::new();
+        let mut used_rows = vec![false; a.len()];
+        loop {
+            // full pivoting over unused rows and free columns
+            let mut best = (0.0, 0, 0);
+            for (i, r) in a.iter().enumerate() {
+                if used_rows[i] {
+                    continue;
+                }
+                for c in 0..3 {
+                    if !pivots.iter().any(|p| p.1 == c) && r[c].abs() > best.0 {
+                        best = (r[c].abs(), i, c);
+                    }
+                }
+            }
+            if best.0 <= 1e-10 {
+                break;
+            }
+            let (_, i, c) = best;
+            used_rows[i] = true;
+            let piv = a[i] / a[i][c];
+            a[i] = piv;
+            for (k, r) in a.iter_mut().enumerate() {
+                if k != i {
+                    let f = r[c];
+                    *r -= f * piv;
+                }
+            }
+            pivots.push((i, c));
+        }
+        let mut t = Matrix3::identity();
+        let mut dep = [false; 3];
+        for &(i, c) in &pivots {
+            dep[c] = true;
+            // u_c + Σ_j a_ij u_j = 0 over the independent j
+            for j in 0..3 {
+                t[(c, j)] = if j == c { 0.0 } else { -a[i][j] };
+            }
+        }
+        for &(_, c) in &pivots {
+            for r in 0..3 {
+                t[(r, c)] = 0.0;
+            }
+        }
+        (t, dep)
+    }
+
+    /// Rebuilds `T` from the planes and the node's fixed dofs.
+    fn rebuild(&mut self, fixed: &[bool]) {
+        let mut tr: Vec<Vector3<f64>> = self.normals.clone();
+        let mut rot = Vec::new();
+        for n in &self.normals {
+            let k = n.iamin();
+            let a = n.cross(&Vector3::ith(k, 1.0)).normalize();
+            rot.push(a);
+            rot.push(n.cross(&a));
+        }
+        for c in 0..3 {
+            if fixed[c] {
+                tr.push(Vector3::ith(c, 1.0));
+            }
+            if fixed[3 + c] {
+                rot.push(Vector3::ith(c, 1.0));
+            }
+        }
+        let (tt, dt) = Self::eliminate(&tr);
+        let (trr, dr) = Self::eliminate(&rot);
+        self.t = nalgebra::Matrix6::zeros();
+        self.t.fixed_view_mut::<3, 3>(0, 0).copy_from(&tt);
+        self.t.fixed_view_mut::<3, 3>(3, 3).copy_from(&trr);
+        self.dependent = [dt[0], dt[1], dt[2], dr[0], dr[1], dr[2]];
+    }
+
+    /// The reduced 6x6 mass block `Tᵀ diag(m) T` of the node (`m` its six lumped masses).
+    fn mass(&self, m: &[f64]) -> nalgebra::Matrix6<f64> {
+        let d = nalgebra::Matrix6::from_diagonal(&nalgebra::Vector6::from_column_slice(m));
+        self.t.transpose() * d * self.t
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -128,6 +237,9 @@ pub struct FeModel {
     /// or are rigid slaves).
     user_fixed: Vec<bool>,
     rigid: Vec<RigidBody>,
+    /// Nodes on skew symmetry planes, and the entry of each node in it.
+    skew: Vec<SkewNode>,
+    skew_of: Vec<Option<usize>>,
     /// Rigid body of each node (master or slave), and whether it is a slave.
     body_of: Vec<Option<usize>>,
     slave: Vec<bool>,
@@ -274,6 +386,8 @@ impl FeModel {
             constrained,
             user_fixed: vec![false; 6 * nn],
             rigid: vec![],
+            skew: vec![],
+            skew_of: vec![None; nn],
             body_of: vec![None; nn],
             slave: vec![false; nn],
             fint_full: vec![],
@@ -358,6 +472,13 @@ impl FeModel {
                 self.mass[6 * s..6 * s + 6].fill(0.0);
             }
         }
+        for k in &self.skew {
+            let d = 6 * k.node;
+            let m = k.mass(&self.node_mass[d..d + 6]);
+            for c in 0..6 {
+                self.mass[d + c] = m[(c, c)];
+            }
+        }
     }
 
     /// Makes `nodes` a rigid body on the master `reference` with the mass and inertia of its
@@ -388,6 +509,9 @@ impl FeModel {
         for &n in &check {
             if n >= nn {
                 return Err(RigidError::NodeRange { node: n, n: nn });
+            }
+            if self.skew_of[n].is_some() {
+                return Err(RigidError::SymmetryPlane { node: n });
             }
             if let Some(body) = self.body_of[n] {
                 return Err(RigidError::TwoBodies { node: n, body });
@@ -454,6 +578,7 @@ impl FeModel {
         self.user_fixed.extend([false; 6]);
         self.external.extend([0.0; 6]);
         self.body_of.push(None);
+        self.skew_of.push(None);
         self.slave.push(false);
         if let Some(b) = &mut self.bt4 {
             b.x.push([p.x, p.y, p.z]);
@@ -571,6 +696,9 @@ impl FeModel {
                     self.user_fixed[6 * n + c] = true;
                 }
             }
+            if let Some(k) = self.skew_of[n] {
+                self.rebuild_skew(k);
+            }
         }
     }
 
@@ -582,6 +710,126 @@ impl FeModel {
         mask[3 + (axis + 1) % 3] = true;
         mask[3 + (axis + 2) % 3] = true;
         self.fix(nodes, mask);
+    }
+
+    /// Symmetry about the plane of unit `normal` (any direction; normalised here) through
+    /// `nodes`: `u·n = 0` and rotation only about `n`. Axis-aligned normals at nodes without a
+    /// skew plane fix dofs as `symmetry` does; others constrain the node's dofs linearly
+    /// (`SkewNode`: dependent dofs marked constrained, forces, tangent and mass reduced by
+    /// the node's `T`, increments and dependent velocities expanded by it), so every solver
+    /// respects them. A node may lie on several planes and have fixed dofs (fix before or
+    /// after); it may not belong to a rigid body or carry a prescribed dof.
+    pub fn symmetry_plane(
+        &mut self,
+        nodes: &[usize],
+        normal: [f64; 3],
+    ) -> Result<(), AssemblyError> {
+        let n = Vector3::from(normal);
+        let len = n.norm();
+        if !len.is_finite() || len == 0.0 {
+            return Err(AssemblyError::BadNormal { normal });
+        }
+        let n = n / len;
+        let nn = self.x0.len();
+        for &node in nodes {
+            if node >= nn {
+                return Err(AssemblyError::NodeRange { node, n: nn });
+            }
+            if self.body_of[node].is_some() {
+                return Err(AssemblyError::SymmetryRigid { node });
+            }
+            if self.prescribed.iter().any(|p| p.0 / 6 == node) {
+                return Err(AssemblyError::SymmetryPrescribed { node });
+            }
+        }
+        let axis = (0..3).find(|&a| n[a].abs() == 1.0);
+        for &node in nodes {
+            match (axis, self.skew_of[node]) {
+                (Some(a), None) => self.symmetry(&[node], a),
+                (_, Some(k)) => {
+                    self.skew[k].normals.push(n);
+                    self.rebuild_skew(k);
+                }
+                (None, None) => {
+                    let d = 6 * node;
+                    let mut base = [false; 6];
+                    base.copy_from_slice(&self.constrained[d..d + 6]);
+                    self.skew_of[node] = Some(self.skew.len());
+                    self.skew.push(SkewNode {
+                        node,
+                        normals: vec![n],
+                        base,
+                        t: nalgebra::Matrix6::identity(),
+                        dependent: [false; 6],
+                    });
+                    self.rebuild_skew(self.skew.len() - 1);
+                }
+            }
+        }
+        self.reduce_mass();
+        Ok(())
+    }
+
+    /// Recomputes skew node `k`'s `T` and its constrained flags.
+    fn rebuild_skew(&mut self, k: usize) {
+        let s = &mut self.skew[k];
+        let d = 6 * s.node;
+        s.rebuild(&self.user_fixed[d..d + 6]);
+        for c in 0..6 {
+            self.constrained[d + c] = s.base[c] || self.user_fixed[d + c] || s.dependent[c];
+        }
+    }
+
+    /// `f ← Tᵀ f` at the skew symmetry nodes.
+    fn reduce_skew_forces(&self, f: &mut [f64]) {
+        for k in &self.skew {
+            let d = 6 * k.node;
+            let r = k.t.transpose() * nalgebra::Vector6::from_column_slice(&f[d..d + 6]);
+            f[d..d + 6].copy_from_slice(r.as_slice());
+        }
+    }
+
+    /// `v ← T v` at the skew symmetry nodes (dependent dofs from the independent ones).
+    fn expand_skew(&self, v: &mut [f64]) {
+        for k in &self.skew {
+            let d = 6 * k.node;
+            let r = k.t * nalgebra::Vector6::from_column_slice(&v[d..d + 6]);
+            v[d..d + 6].copy_from_slice(r.as_slice());
+        }
+    }
+
+    /// `K ← Tᵀ K T` on triplets at the skew symmetry nodes (`T` is constant: no geometric
+    /// term).
+    fn reduce_skew_tangent(&self, k: &mut Vec<Triplet<usize, usize, f64>>) {
+        let expand = |d: usize| -> ([(usize, f64); 3], usize) {
+            let (n, c) = (d / 6, d % 6);
+            let mut out = [(d, 1.0); 3];
+            let Some(s) = self.skew_of[n] else { return (out, 1) };
+            let t = &self.skew[s].t;
+            let mut len = 0;
+            for j in 0..6 {
+                if t[(c, j)] != 0.0 {
+                    out[len] = (6 * n + j, t[(c, j)]);
+                    len += 1;
+                }
+            }
+            (out, len)
+        };
+        let mut out = Vec::with_capacity(k.len());
+        for e in k.iter() {
+            if self.skew_of[e.row / 6].is_none() && self.skew_of[e.col / 6].is_none() {
+                out.push(*e);
+                continue;
+            }
+            let (rows, nr) = expand(e.row);
+            let (cols, nc) = expand(e.col);
+            for &(i, a) in &rows[..nr] {
+                for &(j, b) in &cols[..nc] {
+                    out.push(Triplet::new(i, j, a * e.val * b));
+                }
+            }
+        }
+        *k = out;
     }
 
     /// Prescribes dof `c` of `nodes` to `value · curve(t)`.
@@ -691,6 +939,17 @@ impl Model for FeModel {
 
     fn apply_increment(&mut self, du: &[f64]) {
         self.fint_valid = false;
+        let expanded;
+        let du = if self.skew.is_empty() {
+            du
+        } else {
+            expanded = {
+                let mut v = du.to_vec();
+                self.expand_skew(&mut v);
+                v
+            };
+            &expanded
+        };
         let s = &mut self.trial;
         for n in 0..s.x.len() {
             if self.slave[n] {
@@ -760,10 +1019,12 @@ impl Model for FeModel {
             self.fint_valid = true;
             self.reduce_forces(f);
         }
+        self.reduce_skew_forces(f);
     }
 
     fn external_force(&mut self, t: f64, f: &mut [f64]) {
         self.external_unreduced(t, f);
+        self.reduce_skew_forces(f);
         if self.rigid.is_empty() {
             return;
         }
@@ -791,6 +1052,9 @@ impl Model for FeModel {
         if !self.rigid.is_empty() {
             self.reduce_tangent(t, out);
         }
+        if !self.skew.is_empty() {
+            self.reduce_skew_tangent(out);
+        }
     }
 
     fn apply_inverse_mass(&self, f: &[f64], a: &mut [f64]) {
@@ -803,6 +1067,21 @@ impl Model for FeModel {
             let am = b.inverse_mass(&self.trial.r[b.master], &c[d..d + 6], &f[d..d + 6]);
             a[d..d + 6].copy_from_slice(am.as_slice());
         }
+        for k in &self.skew {
+            let d = 6 * k.node;
+            let mut mk = k.mass(&self.node_mass[d..d + 6]);
+            let mut rhs = nalgebra::Vector6::from_column_slice(&f[d..d + 6]);
+            for i in 0..6 {
+                if c[d + i] || mk[(i, i)] <= 0.0 {
+                    mk.row_mut(i).fill(0.0);
+                    mk.column_mut(i).fill(0.0);
+                    mk[(i, i)] = 1.0;
+                    rhs[i] = 0.0;
+                }
+            }
+            let ak = mk.cholesky().map_or(nalgebra::Vector6::zeros(), |ch| ch.solve(&rhs));
+            a[d..d + 6].copy_from_slice(ak.as_slice());
+        }
     }
 
     fn mass_product(&self, v: &[f64], out: &mut [f64]) {
@@ -813,6 +1092,12 @@ impl Model for FeModel {
             let d = 6 * b.master;
             let vm = nalgebra::Vector6::from_column_slice(&v[d..d + 6]);
             let p = b.mass6(&self.trial.r[b.master]) * vm;
+            out[d..d + 6].copy_from_slice(p.as_slice());
+        }
+        for k in &self.skew {
+            let d = 6 * k.node;
+            let vk = nalgebra::Vector6::from_column_slice(&v[d..d + 6]);
+            let p = k.mass(&self.node_mass[d..d + 6]) * vk;
             out[d..d + 6].copy_from_slice(p.as_slice());
         }
     }
@@ -827,6 +1112,17 @@ impl Model for FeModel {
                     let v = if i == j { m6[(i, j)] - self.mass[d + i] } else { m6[(i, j)] };
                     if v != 0.0 {
                         out.push(Triplet::new(d + i, d + j, v));
+                    }
+                }
+            }
+        }
+        for k in &self.skew {
+            let d = 6 * k.node;
+            let mk = k.mass(&self.node_mass[d..d + 6]);
+            for i in 0..6 {
+                for j in 0..6 {
+                    if i != j && mk[(i, j)] != 0.0 {
+                        out.push(Triplet::new(d + i, d + j, mk[(i, j)]));
                     }
                 }
             }
@@ -871,6 +1167,8 @@ impl Model for FeModel {
                 a[6 * s + 3..6 * s + 6].copy_from_slice(al.as_slice());
             }
         }
+        self.expand_skew(v);
+        self.expand_skew(a);
     }
 
     fn commit(&mut self) {

@@ -51,6 +51,8 @@ pub enum RigidError {
     TwoBodies { node: usize, body: usize },
     #[error("rigid body: slave node {node} has its dof {dof} fixed or prescribed (only the reference node of a body may be constrained)")]
     ConstrainedSlave { node: usize, dof: usize },
+    #[error("rigid body: node {node} lies on a skew symmetry plane")]
+    SymmetryPlane { node: usize },
     #[error("rigid body: the extra mass and inertia must be finite, the mass >= 0 and the inertia symmetric positive semi-definite")]
     BadExtra,
     #[error("rigid body: the body has no mass, so no mass centre for its reference node")]

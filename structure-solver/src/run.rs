@@ -18,7 +18,7 @@ use std::time::{Instant, SystemTime};
 use anyhow::{anyhow, bail, Context};
 use interface_protocol::case::{
     BeamSectionSpec, Case, CurveName, CurveSpec, ElementType, Integrator, LoadKind,
-    StructureMaterial, StructureMesh, StructureSection,
+    StructureMaterial, StructureMesh, StructureSection, Symmetry,
 };
 use interface_protocol::io::checkpoint::{self, Checkpoint};
 use interface_protocol::io::outdir::{default_run_dir, OutputDir, Policy};
@@ -481,6 +481,7 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
     }
     let statics = s.integrator() == Integrator::Static;
     let default_curve = if statics { Curve::Linear } else { Curve::Constant };
+    let mut skew = Vec::new();
     for (k, bc) in s.bc.iter().enumerate() {
         let f = format!("structure.bc[{k}]");
         let nodes = node_set(&mesh, &bc.set, &format!("{f}.set"), file)?;
@@ -500,8 +501,10 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
             bc.fixed.iter().for_each(|d| mask[d.index()] = true);
             fe.fix(&nodes, mask);
         }
-        if let Some(axis) = bc.symmetry {
-            fe.symmetry(&nodes, axis.index());
+        match bc.symmetry {
+            Some(Symmetry::Axis(axis)) => fe.symmetry(&nodes, axis.index()),
+            Some(Symmetry::Normal(n)) => skew.push((format!("{f}.symmetry"), nodes.clone(), n)),
+            None => {}
         }
         if let Some(p) = &bc.prescribed {
             fe.prescribe(
@@ -511,6 +514,10 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
                 curve(p.curve.as_ref(), default_curve.clone()),
             );
         }
+    }
+    // planes of any normal after the fixed and prescribed dofs they combine with
+    for (f, nodes, n) in skew {
+        fe.symmetry_plane(&nodes, n).map_err(|e| field_error(file, &f, e))?;
     }
     for (k, l) in s.loads.iter().enumerate() {
         let f = format!("structure.loads[{k}]");

@@ -72,6 +72,7 @@
 //! set = "clamp"
 //! fixed = ["ux", "uy", "uz", "rx", "ry", "rz"]
 //! # symmetry = "y"                  # plane normal to y: uy = rx = rz = 0
+//! # symmetry = [0.5, 0.866, 0]      # any normal: u·n = 0, rotation only about n
 //! # prescribed = { dof = "uz", value = 0.01, curve = "linear" }   # value x curve(t)
 //!
 //! # Curves of time (the load factor in static runs): "constant", "linear" (= t),
@@ -428,6 +429,14 @@ impl Axis {
     }
 }
 
+/// `symmetry`: a plane normal to a global axis, or to any (non-zero) vector.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(untagged, expecting = "a symmetry plane: \"x\", \"y\", \"z\" or a normal [nx, ny, nz]")]
+pub enum Symmetry {
+    Axis(Axis),
+    Normal([f64; 3]),
+}
+
 /// A scalar function of time (the load factor in static runs).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(
@@ -492,9 +501,9 @@ pub struct StructureBc {
     /// Dofs held at zero.
     #[serde(default)]
     pub fixed: Vec<Dof>,
-    /// Symmetry about the plane normal to this axis.
+    /// Symmetry about the plane normal to this axis or vector.
     #[serde(default)]
-    pub symmetry: Option<Axis>,
+    pub symmetry: Option<Symmetry>,
     #[serde(default)]
     pub prescribed: Option<Prescribed>,
 }
@@ -748,10 +757,17 @@ impl StructureSection {
             if given.iter().filter(|g| **g).count() != 1 {
                 return Err((
                     f,
-                    "expected exactly one of `fixed = [dofs]`, `symmetry = \"x|y|z\"`, \
+                    "expected exactly one of `fixed = [dofs]`, `symmetry = \"x|y|z\"` (or a \
+                     normal `[nx, ny, nz]`), \
                      `prescribed = { dof, value, curve }`"
                         .into(),
                 ));
+            }
+            if let Some(Symmetry::Normal(n)) = b.symmetry {
+                finite(&format!("{f}.symmetry"), &n)?;
+                if n.iter().all(|c| *c == 0.0) {
+                    return Err((format!("{f}.symmetry"), "expected a non-zero normal".into()));
+                }
             }
             if let Some(p) = &b.prescribed {
                 finite(&format!("{f}.prescribed.value"), &[p.value])?;

@@ -118,7 +118,7 @@ set = "all"
     let s = parse(text).unwrap().structure.unwrap();
     assert!(matches!(s.mesh, Some(StructureMesh::Sphere { n_phi: 8, phi_deg: [18.0, 90.0], .. })));
     assert_eq!(s.control.as_ref().unwrap().dof, Dof::Ux);
-    assert_eq!(s.bc[0].symmetry, Some(Axis::Z));
+    assert_eq!(s.bc[0].symmetry, Some(Symmetry::Axis(Axis::Z)));
     assert_eq!(s.bc[1].prescribed.as_ref().unwrap().dof.index(), 4);
     assert!(matches!(s.loads[1].kind(), Some(LoadKind::Pressure { set: Some("all"), p: 1e3 })));
 }
