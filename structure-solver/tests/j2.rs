@@ -49,6 +49,27 @@ fn elastic_stress_is_the_energy_gradient_and_tangent_the_stress_gradient() {
     }
 }
 
+/// Largest `|∂σ/∂ε (central differences) - C| / E` of a return map `stress` at `eps`.
+fn tangent_error<const N: usize>(
+    eps: [f64; N],
+    c: &[[f64; N]; N],
+    e: f64,
+    stress: impl Fn(&[f64; N]) -> [f64; N],
+) -> f64 {
+    let h = 1e-9;
+    let mut worst: f64 = 0.0;
+    for i in 0..N {
+        let (mut ep, mut em) = (eps, eps);
+        ep[i] += h;
+        em[i] -= h;
+        let (sp, sm) = (stress(&ep), stress(&em));
+        for j in 0..N {
+            worst = worst.max(((sp[j] - sm[j]) / (2.0 * h) - c[j][i]).abs() / e);
+        }
+    }
+    worst
+}
+
 #[test]
 fn j2_3d_consistent_tangent_matches_finite_differences_of_the_return_map() {
     let m = steel();
@@ -56,18 +77,7 @@ fn j2_3d_consistent_tangent_matches_finite_differences_of_the_return_map() {
     let eps = [4.5e-3, -1.5e-3, -2.0e-3, 3e-3, 1e-3, -2e-3];
     let (_, new, c) = m.update_3d(&eps, &state);
     assert!(new.alpha > state.alpha, "the point must be plastic for this test");
-    let h = 1e-9;
-    let mut worst: f64 = 0.0;
-    for i in 0..6 {
-        let (mut ep, mut em) = (eps, eps);
-        ep[i] += h;
-        em[i] -= h;
-        let (sp, _, _) = m.update_3d(&ep, &state);
-        let (sm, _, _) = m.update_3d(&em, &state);
-        for j in 0..6 {
-            worst = worst.max(((sp[j] - sm[j]) / (2.0 * h) - c[j][i]).abs() / m.elastic.e);
-        }
-    }
+    let worst = tangent_error(eps, &c, m.elastic.e, |e| m.update_3d(e, &state).0);
     println!("3D tangent vs FD: max error / E = {worst:.3e}");
     assert!(worst < 1e-6);
 }
@@ -79,18 +89,7 @@ fn j2_plane_stress_consistent_tangent_matches_finite_differences_of_the_return_m
     for eps in [[5e-3, -1e-3, 2e-3], [3e-3, 3.1e-3, 0.0], [1e-3, -2e-3, 6e-3]] {
         let (_, new, c) = m.update_plane_stress(&eps, &state);
         assert!(new.alpha > state.alpha, "the point must be plastic for this test");
-        let h = 1e-9;
-        let mut worst: f64 = 0.0;
-        for i in 0..3 {
-            let (mut ep, mut em) = (eps, eps);
-            ep[i] += h;
-            em[i] -= h;
-            let (sp, _, _) = m.update_plane_stress(&ep, &state);
-            let (sm, _, _) = m.update_plane_stress(&em, &state);
-            for j in 0..3 {
-                worst = worst.max(((sp[j] - sm[j]) / (2.0 * h) - c[j][i]).abs() / m.elastic.e);
-            }
-        }
+        let worst = tangent_error(eps, &c, m.elastic.e, |e| m.update_plane_stress(e, &state).0);
         println!("plane-stress tangent vs FD at {eps:?}: max error / E = {worst:.3e}");
         assert!(worst < 1e-6);
     }
