@@ -1,6 +1,9 @@
 //! The command line every participant accepts, so the launcher can start any of them the same
 //! way (DESIGN §1): `<solver> run CASE [--couple RUN_ID] [--out DIR] [--set KEY=VALUE]... [--quiet]`.
-//! A solver flattens `RunArgs` into its own `run` subcommand and adds what only it has.
+//! A solver flattens `RunArgs` into its own `run` subcommand and adds what only it has, and
+//! offers `<solver> check CASE [--set KEY=VALUE]...` ([`CheckArgs`]): everything `run` does before
+//! its first step (mesh, sets, EOS, states, probes), then exit 0, or an error naming the file,
+//! line or field and exit non-zero. `fsi check` calls each participant's `check`.
 
 use crate::case::{Case, CaseError};
 use std::path::PathBuf;
@@ -23,6 +26,27 @@ pub struct RunArgs {
     /// No progress bar or summary.
     #[arg(long)]
     pub quiet: bool,
+    /// Reuse an output folder that holds a previous run, removing that run's files first.
+    /// Without it a non-empty output folder is refused (never overwritten silently).
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Arguments of `check`, common to every participant.
+#[derive(clap::Args, Debug, Clone)]
+pub struct CheckArgs {
+    /// The case file.
+    pub case: PathBuf,
+    /// Override a case key, as for `run` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl CheckArgs {
+    /// Reads the case with the `--set` overrides applied.
+    pub fn load_case(&self) -> Result<Case, CaseError> {
+        Case::load(&self.case, &self.set)
+    }
 }
 
 impl RunArgs {
@@ -61,6 +85,9 @@ mod tests {
         assert_eq!(cli.run.out, Some(PathBuf::from("o")));
         assert_eq!(cli.run.set, ["a.b=1", "c=2"]);
         assert!(!cli.run.quiet);
+        assert!(!cli.run.force);
+        let forced = Cli::try_parse_from(["x", "c.toml", "--force"]).unwrap();
+        assert!(forced.run.force);
     }
 
     #[test]

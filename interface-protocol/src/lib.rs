@@ -1,7 +1,8 @@
 //! The contract between the FSI solvers: the `#[repr(C)]` messages that cross iceoryx2 shared
 //! memory, the endpoints that hide iceoryx2 from solver code, the coupling formulas of the
-//! staggered schemes, the case-file parser shared by all executables and (feature `io`) the run
-//! outputs both solvers write.
+//! staggered schemes, the case-file parser shared by all executables and the run outputs
+//! ([`io`]: the output folder, probes, checkpoints everywhere; HDF5/XDMF, progress bar and
+//! `run.json` with feature `io`).
 //!
 //! Owns: message layout, service names, handshake, liveness, case parsing, coupling formulas.
 //! Must not touch: fluid or structure physics; it stays light enough for foreign peers and the
@@ -16,10 +17,10 @@ pub mod handshake;
 pub mod liveness;
 pub mod messages;
 pub mod participant;
+pub mod resources;
 pub mod services;
 pub mod shm;
 
 #[cfg(feature = "cli")]
 pub mod cli;
-#[cfg(feature = "io")]
 pub mod io;

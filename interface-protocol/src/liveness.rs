@@ -1,5 +1,5 @@
-//! Liveness of a participant (DESIGN §3): it ends cleanly on SIGTERM/SIGINT and when the launcher
-//! dies, and every wait checks both once per poll slice (`POLL_SLICE`).
+//! Liveness of a participant (DESIGN §3): it ends cleanly on SIGTERM, SIGINT or SIGHUP and when
+//! the launcher dies, and every wait checks both once per poll slice (`POLL_SLICE`).
 //!
 //! iceoryx2's own handling is disabled (it would swallow SIGTERM); the handler here only records
 //! the signal, and the waits in `endpoint` turn it into `ProtocolError::Terminated`. The launcher
@@ -23,9 +23,12 @@ extern "C" fn record_signal(signal: libc::c_int) {
     RECEIVED.store(signal, Ordering::SeqCst);
 }
 
-/// Installs the SIGTERM/SIGINT handler that records the signal (idempotent).
+/// The signals that end a run cleanly: recorded, then acted on at the next poll slice.
+pub const TERMINATION_SIGNALS: [libc::c_int; 3] = [libc::SIGTERM, libc::SIGINT, libc::SIGHUP];
+
+/// Installs the handler of `TERMINATION_SIGNALS` that records the signal (idempotent).
 pub fn install_signal_handlers() {
-    for signal in [libc::SIGTERM, libc::SIGINT] {
+    for signal in TERMINATION_SIGNALS {
         // SAFETY: `sigaction` with a zeroed struct, an empty mask and a handler that only stores
         // into an atomic (async-signal-safe) is the documented way to install a handler.
         unsafe {
@@ -172,6 +175,12 @@ mod tests {
                 std::thread::sleep(Duration::from_secs(30));
                 drop(s);
             }
+            "link" => {
+                // A launcher's start-up in a run holding a dead node; iceoryx2 logs go to stderr.
+                let link = LauncherLink::open(&run_id, Timeouts::default()).unwrap();
+                drop(link);
+                std::fs::write(&out, "done").unwrap();
+            }
             "launcher" => {
                 let mut c = reexec("participant", &run_id, Path::new(&out));
                 c.env(super::LAUNCHER_PID_ENV, std::process::id().to_string());
@@ -239,6 +248,40 @@ mod tests {
         link.remove_resources().unwrap();
         assert!(shm::run_files(&run_id).is_empty());
         let _ = std::fs::remove_file(&out);
+    }
+
+    #[test]
+    fn a_dead_node_without_its_details_draws_no_global_config_warning() {
+        let run_id = format!("t{}-nodetails", std::process::id());
+        let out = std::env::temp_dir().join(format!("fsi-{run_id}.txt"));
+        let _ = std::fs::remove_file(&out);
+        let mut child = reexec("stale", &run_id, &out).spawn().unwrap();
+        outcome(&out, Instant::now());
+        kill(&child, libc::SIGKILL);
+        child.wait().unwrap();
+        // A node killed while it was created or removed: its monitor is there, its details not.
+        let details: Vec<_> =
+            shm::run_files(&run_id).into_iter().filter(|p| p.ends_with_details()).collect();
+        assert!(!details.is_empty(), "no node details among {:?}", shm::run_files(&run_id));
+        details.iter().for_each(|p| std::fs::remove_file(p).unwrap());
+        let _ = std::fs::remove_file(&out);
+        let logged =
+            reexec("link", &run_id, &out).stderr(std::process::Stdio::piped()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&logged.stderr);
+        assert_eq!(std::fs::read_to_string(&out).unwrap_or_default(), "done", "{stderr}");
+        assert!(!stderr.contains("global_config"), "iceoryx2 warned:\n{stderr}");
+        shm::cleanup_run(&run_id).unwrap();
+        let _ = std::fs::remove_file(&out);
+    }
+
+    trait DetailsFile {
+        fn ends_with_details(&self) -> bool;
+    }
+
+    impl DetailsFile for PathBuf {
+        fn ends_with_details(&self) -> bool {
+            self.extension().is_some_and(|e| e == "details")
+        }
     }
 
     #[test]

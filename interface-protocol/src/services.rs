@@ -3,7 +3,8 @@
 //! Every resource of a run lives under its own file prefix `fsi_<run_id>_` and every service is
 //! named `fsi/<run_id>/<name>`, so concurrent runs and tests never see each other, and "no file of
 //! this run remains" is one glob (see `shm::cleanup_run`). The configuration is built in code: no
-//! config file is read and iceoryx2's own signal handling is disabled (see `liveness`).
+//! config file is read, iceoryx2's own signal handling is disabled (see `liveness`) and so is its
+//! automatic clean-up of dead nodes (see [`config`]).
 
 use crate::messages::Role;
 use iceoryx2::config::Config;
@@ -68,13 +69,23 @@ pub fn service_name(run_id: &str, name: &str) -> Result<ServiceName, ProtocolErr
         .map_err(|e| ProtocolError::Setup(format!("invalid service name `{full}`: {e:?}")))
 }
 
-/// The iceoryx2 configuration of a run: defaults, with the run's file prefix.
+/// The iceoryx2 configuration of a run: defaults, with the run's file prefix and without
+/// iceoryx2's clean-up of dead nodes when a node is created or dropped or a service opened.
+///
+/// That clean-up reads a dead node's configuration from its details file, and when the file is
+/// gone (the node died while being created or removed) falls back to `Config::global_config()`,
+/// which looks for a config file and warns on stderr. A run's files are removed by prefix
+/// instead: by the launcher when the run ends, and by the next launcher when a run died
+/// (`shm::cleanup_stale_runs`).
 pub fn config(run_id: &str) -> Result<Config, ProtocolError> {
     validate_run_id(run_id)?;
     let mut config = Config::default();
     let p = prefix(run_id);
     config.global.prefix = FileName::new(p.as_bytes())
         .map_err(|e| ProtocolError::Setup(format!("invalid file prefix `{p}`: {e:?}")))?;
+    config.global.node.cleanup_dead_nodes_on_creation = false;
+    config.global.node.cleanup_dead_nodes_on_destruction = false;
+    config.global.service.cleanup_dead_nodes_on_open = false;
     Ok(config)
 }
 
@@ -106,5 +117,14 @@ mod tests {
             assert!(e.contains("invalid run id"), "{e}");
         }
         assert_eq!(service_name("r1", KINEMATICS).unwrap().as_str(), "fsi/r1/surface/kinematics");
+    }
+
+    #[test]
+    fn the_config_never_cleans_dead_nodes_itself() {
+        let c = config("r1").unwrap();
+        assert_eq!(c.global.prefix.as_bytes(), b"fsi_r1_");
+        assert!(!c.global.node.cleanup_dead_nodes_on_creation);
+        assert!(!c.global.node.cleanup_dead_nodes_on_destruction);
+        assert!(!c.global.service.cleanup_dead_nodes_on_open);
     }
 }

@@ -1,10 +1,14 @@
 //! Shared-memory housekeeping (DESIGN §3): room in `/dev/shm` before allocating (a full tmpfs
-//! shows up later as SIGBUS), removal of every file of a run, and of runs whose nodes all died.
+//! shows up later as SIGBUS), the launcher's claim on its run id ([`RunLock`]), removal of every
+//! file of a run, and of runs that died.
 
 use crate::endpoint::ProtocolError;
 use crate::services;
 use iceoryx2::prelude::{ipc, CallbackProgression, Node, NodeState};
 use std::path::{Path, PathBuf};
+
+mod lock;
+pub use lock::{lock_path, RunLock};
 
 /// Where iceoryx2 maps its shared memory.
 pub const SHM_DIR: &str = "/dev/shm";
@@ -71,16 +75,24 @@ fn collect(dir: &Path, prefix: &str, recursive: bool, out: &mut Vec<PathBuf>) {
 /// Removes every file of a run (call it only when no process of the run is alive). Returns the
 /// number of files removed.
 pub fn cleanup_run(run_id: &str) -> Result<usize, ProtocolError> {
+    cleanup_run_except(run_id, None)
+}
+
+/// `cleanup_run`, keeping the file `keep` (the lock of the launcher that reuses the run id).
+fn cleanup_run_except(run_id: &str, keep: Option<&Path>) -> Result<usize, ProtocolError> {
     services::validate_run_id(run_id)?;
     let mut removed = 0;
-    for path in run_files(run_id) {
+    for path in run_files(run_id).into_iter().filter(|p| Some(p.as_path()) != keep) {
         let r = if path.is_dir() {
             std::fs::remove_dir_all(&path)
         } else {
             std::fs::remove_file(&path)
         };
         match r {
-            Ok(()) => removed += 1,
+            Ok(()) => {
+                removed += 1;
+                remove_empty_node_dir(&path);
+            }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
             Err(e) => {
                 return Err(ProtocolError::Setup(format!("cannot remove {}: {e}", path.display())))
@@ -88,6 +100,16 @@ pub fn cleanup_run(run_id: &str) -> Result<usize, ProtocolError> {
         }
     }
     Ok(removed)
+}
+
+/// iceoryx2 keeps a node's files in `/tmp/iceoryx2/nodes/<node id>/`, a folder without the run's
+/// prefix: it goes with the node's last file.
+fn remove_empty_node_dir(removed: &Path) {
+    let Some(dir) = removed.parent() else { return };
+    if dir.parent() == Some(Path::new(ROOT_DIR).join("nodes").as_path()) {
+        // Fails, harmlessly, while the folder holds anything.
+        let _ = std::fs::remove_dir(dir);
+    }
 }
 
 /// Run ids that own files in `/dev/shm` or `/tmp/iceoryx2`.
@@ -108,9 +130,15 @@ pub fn runs_on_disk() -> Vec<String> {
     ids.into_iter().collect()
 }
 
-/// Whether any node of the run is alive (or cannot be inspected, which counts as alive).
+/// Whether any node of the run is alive (or cannot be inspected, which counts as alive). A run
+/// with no file under `/tmp/iceoryx2` (where node descriptions live) has no node.
 pub fn run_has_live_node(run_id: &str) -> bool {
     let Ok(config) = services::config(run_id) else { return false };
+    let mut node_files = Vec::new();
+    collect(Path::new(ROOT_DIR), &services::prefix(run_id), true, &mut node_files);
+    if node_files.is_empty() {
+        return false;
+    }
     let mut alive = false;
     let listed = Node::<ipc::Service>::list(&config, |state| {
         if !matches!(state, NodeState::Dead(_)) {
@@ -135,15 +163,25 @@ fn run_is_recent(run_id: &str, min_age: std::time::Duration) -> bool {
     })
 }
 
-/// Removes the files of every run whose nodes are all dead and whose files are older than
-/// `min_age` (DESIGN §3: stale resources of dead runs are cleaned at start; launchers pass
-/// `STALE_AFTER` so a concurrently starting run is safe). Returns the run ids cleaned.
+/// Removes the files of every dead run (DESIGN §3: stale resources of dead runs are cleaned at
+/// start). A run started by a launcher is dead once its launcher's [`RunLock`] is free and none of
+/// its nodes is alive; a run without a lock (participants joined by hand, `fsi bench`) once its
+/// nodes are all dead and its files older than `min_age` (launchers pass `STALE_AFTER`, so a run
+/// that is starting up is safe). Returns the run ids cleaned.
 pub fn cleanup_stale_runs(min_age: std::time::Duration) -> Vec<String> {
     runs_on_disk().into_iter().filter(|id| cleanup_if_stale(id, min_age)).collect()
 }
 
-/// Removes a run's files if all its nodes are dead and its files are older than `min_age`;
-/// returns whether it did.
+/// Removes a run's files if it is dead (see [`cleanup_stale_runs`]); returns whether it did.
 pub fn cleanup_if_stale(run_id: &str, min_age: std::time::Duration) -> bool {
-    !run_is_recent(run_id, min_age) && !run_has_live_node(run_id) && cleanup_run(run_id).is_ok()
+    match lock::claim_dead(run_id) {
+        lock::Claim::Held => false,
+        // Held while the files go, so that no launcher reuses the id half-way.
+        lock::Claim::Dead(_claim) => !run_has_live_node(run_id) && cleanup_run(run_id).is_ok(),
+        lock::Claim::Absent => {
+            !run_is_recent(run_id, min_age)
+                && !run_has_live_node(run_id)
+                && cleanup_run(run_id).is_ok()
+        }
+    }
 }

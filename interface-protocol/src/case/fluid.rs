@@ -136,7 +136,12 @@ pub struct InitialRegion {
 
 /// A region of space (points on its surface count as inside).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(
+    tag = "shape",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    expecting = "a region table with a `shape` key, e.g. { shape = \"box\", lo = [...], hi = [...] }"
+)]
 pub enum Region {
     /// `(x - point) · normal >= 0`.
     HalfSpace {
@@ -210,7 +215,12 @@ impl Region {
 
 /// A boundary condition (`kind` key).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    expecting = "a boundary table with a `kind` key, e.g. { kind = \"slip_wall\" }"
+)]
 pub enum FluidBoundary {
     SlipWall,
     Symmetry,
@@ -269,7 +279,7 @@ impl Default for FluidNumerics {
 pub struct FluidTime {
     /// End time.
     pub t_end: f64,
-    /// Stop after this many steps even before `t_end`.
+    /// Stop after this many steps even before `t_end` (at most `resources::MAX_STEPS`).
     #[serde(default)]
     pub max_steps: Option<u64>,
 }
@@ -292,7 +302,9 @@ pub struct FluidLine {
     /// Number of sample points (>= 2).
     #[serde(default = "hundred")]
     pub points: usize,
-    /// Times at which to write the line (the first step reaching each); default: the end only.
+    /// Times at which to write the line, each in `lines/<name>_t<time>.csv` (the step that would
+    /// pass one is shortened to land on it); the final state is always written to
+    /// `lines/<name>.csv`.
     #[serde(default)]
     pub times: Vec<f64>,
 }
@@ -396,12 +408,27 @@ impl FluidSection {
         }
         if let Some(t) = &self.time {
             super::require_positive("fluid.time.t_end", t.t_end)?;
+            let cap = crate::resources::MAX_STEPS;
+            if let Some(m) = t.max_steps.filter(|&m| m > cap) {
+                return Err((
+                    "fluid.time.max_steps".into(),
+                    format!("expected at most {cap} steps, got {m}"),
+                ));
+            }
         }
         for (k, l) in self.lines.iter().enumerate() {
             if l.points < 2 {
                 return Err((
                     format!("fluid.lines[{k}].points"),
                     "expected at least 2 points".into(),
+                ));
+            }
+            if let Some((j, t)) =
+                l.times.iter().enumerate().find(|(_, t)| !(**t >= 0.0 && t.is_finite()))
+            {
+                return Err((
+                    format!("fluid.lines[{k}].times[{j}]"),
+                    format!("expected a finite time >= 0, got {t}"),
                 ));
             }
         }

@@ -11,6 +11,7 @@
 
 mod coupling;
 mod fluid;
+mod locate;
 mod output;
 mod piston;
 mod rigid;
@@ -63,6 +64,10 @@ pub struct CaseSource {
     pub path: PathBuf,
     /// 64-bit FNV-1a of the effective document (after overrides), in canonical TOML form.
     pub hash: u64,
+    /// The file's text as read (before overrides), to locate fields in errors.
+    pub text: String,
+    /// The dotted keys given by `--set`, whose values are not in `text`.
+    pub overridden: Vec<String>,
 }
 
 impl Case {
@@ -86,18 +91,19 @@ impl Case {
         let mut doc: toml::Table =
             toml::from_str(text).map_err(|e| CaseError::from_toml(&file, text, &e))?;
         if !overrides.is_empty() {
+            let before = doc.clone();
             for o in overrides {
                 apply_override(&mut doc, o).map_err(|message| CaseError {
                     file: file.clone(),
                     location: None,
-                    field: Some(o.split('=').next().unwrap_or("").trim().to_string()),
+                    field: Some(override_field(o)),
                     message: format!("in --set {o}: {message}"),
                 })?;
             }
             case = Case::deserialize(toml::Value::Table(doc.clone())).map_err(|e| CaseError {
                 file: file.clone(),
                 location: None,
-                field: None,
+                field: Some(first_bad_override(before, overrides)),
                 message: format!("after --set overrides: {}", e.message()),
             })?;
         }
@@ -111,19 +117,45 @@ impl Case {
                 .unwrap_or_else(|| "case".to_string());
         }
         let canonical = toml::to_string(&doc).unwrap_or_default();
-        case.source = CaseSource { path: path.to_path_buf(), hash: fnv1a64(canonical.as_bytes()) };
-        case.validate().map_err(|(field, message)| CaseError {
-            file,
-            location: locate_key(text, &field),
-            field: Some(field),
-            message,
-        })?;
+        case.source = CaseSource {
+            path: path.to_path_buf(),
+            hash: fnv1a64(canonical.as_bytes()),
+            text: text.to_string(),
+            overridden: overrides.iter().map(|o| override_field(o)).collect(),
+        };
+        case.validate().map_err(|(field, message)| case.field_error(&field, message))?;
         Ok(case)
     }
 
     /// The folder of the case file; relative paths in the case are relative to it.
     pub fn dir(&self) -> PathBuf {
         self.source.path.parent().map(Path::to_path_buf).unwrap_or_default()
+    }
+
+    /// An error about `field` (dotted, e.g. `fluid.eos.gamma` or `fluid.probes[2].point`) found
+    /// after parsing, by validation or by a solver's own setup: it names the file, the line and
+    /// column where the field (or its nearest written ancestor) is written, and the field. A field
+    /// given by `--set` is named as such instead of pointing into the file.
+    pub fn field_error(&self, field: &str, message: impl Into<String>) -> CaseError {
+        let mut message = message.into();
+        let overridden = self.source.overridden.iter().find(|key| {
+            field == key.as_str()
+                || field.strip_prefix(key.as_str()).is_some_and(|r| r.starts_with(['.', '[']))
+        });
+        let location = match overridden {
+            Some(key) => {
+                message.push_str(&format!(" (value given by --set {key}=...)"));
+                None
+            }
+            None => locate::locate_offset(&self.source.text, field)
+                .map(|offset| line_col(&self.source.text, offset)),
+        };
+        CaseError {
+            file: self.source.path.display().to_string(),
+            location,
+            field: Some(field.to_string()),
+            message,
+        }
     }
 
     /// The case hash exchanged in the handshake.
@@ -173,8 +205,11 @@ impl std::error::Error for CaseError {}
 
 impl CaseError {
     fn from_toml(file: &str, text: &str, e: &toml::de::Error) -> CaseError {
-        let location = e.span().map(|s| line_col(text, s.start));
-        let field = e.span().map(|s| field_at(text, s.start)).filter(|f| !f.is_empty());
+        let offset = e.span().map(|s| left_open_above(text, s.start, e.message()));
+        let location = offset.map(|o| line_col(text, o));
+        let field = offset
+            .map(|o| locate::path_at(text, o).unwrap_or_else(|| field_at(text, o)))
+            .filter(|f| !f.is_empty());
         CaseError {
             file: file.to_string(),
             location,
@@ -182,6 +217,22 @@ impl CaseError {
             message: e.message().trim().to_string(),
         }
     }
+}
+
+/// Where to report a syntax error the parser found at `offset`: an array or inline table left
+/// open is only noticed at the start of the next line (a missing `,` or closing bracket), so such
+/// an error is reported at the end of the previous non-blank line, where the open value is.
+fn left_open_above(text: &str, offset: usize, message: &str) -> usize {
+    let offset = offset.min(text.len());
+    let at_line_start = text[..offset].trim_end_matches([' ', '\t']).ends_with('\n');
+    let open = ["missing comma", "expected `]`", "expected `}`", "expected `,`"];
+    if !at_line_start || !open.iter().any(|m| message.contains(m)) {
+        return offset;
+    }
+    let above = text[..offset].trim_end();
+    let line_start = above.rfind('\n').map_or(0, |i| i + 1);
+    let line = &above[line_start..];
+    line_start + (line.len() - line.trim_start().len())
 }
 
 /// 1-based line and column of a byte offset.
@@ -215,55 +266,26 @@ fn field_at(text: &str, offset: usize) -> String {
     }
 }
 
-/// Line and column of a dotted key's definition, if it can be found in the text.
-fn locate_key(text: &str, dotted: &str) -> Option<(usize, usize)> {
-    if let Some((table, rest)) = dotted.split_once('[') {
-        return locate_entry_key(text, table, rest);
+/// The field an override names: its key, else the whole assignment, else `--set` itself.
+fn override_field(assignment: &str) -> String {
+    match assignment.split('=').next().map(str::trim) {
+        Some(key) if !key.is_empty() => key.to_string(),
+        _ if !assignment.trim().is_empty() => assignment.to_string(),
+        _ => "--set".to_string(),
     }
-    let (table, key) = dotted.rsplit_once('.').unwrap_or(("", dotted));
-    let mut current = String::new();
-    let mut offset = 0;
-    for l in text.split_inclusive('\n') {
-        let t = l.trim();
-        if t.starts_with('[') {
-            current = t.trim_matches(|c| c == '[' || c == ']').trim().to_string();
-        } else if current == table && t.split('=').next().map(str::trim) == Some(key) {
-            return Some(line_col(text, offset + (l.len() - l.trim_start().len())));
-        }
-        offset += l.len();
-    }
-    None
 }
 
-/// `table[k].key...` (`rest` = `k].key...`): the line of `key` in the `k`-th `[[table]]`
-/// entry, else the entry's header.
-fn locate_entry_key(text: &str, table: &str, rest: &str) -> Option<(usize, usize)> {
-    let (index, key) = rest.split_once(']')?;
-    let index: usize = index.parse().ok()?;
-    let key = key.trim_start_matches('.').split(['.', '[']).next().unwrap_or("");
-    let (mut seen, mut header, mut offset) = (0, None, 0);
-    for l in text.split_inclusive('\n') {
-        let t = l.trim();
-        let here = line_col(text, offset + (l.len() - l.trim_start().len()));
-        if t.starts_with('[') {
-            if header.is_some() {
-                break;
-            }
-            if t.starts_with("[[") && t.trim_matches(|c| c == '[' || c == ']').trim() == table {
-                seen += 1;
-                if seen == index + 1 {
-                    header = Some(here);
-                }
-            }
-        } else if header.is_some()
-            && !key.is_empty()
-            && t.split('=').next().map(str::trim) == Some(key)
+/// The key of the first override after which `doc` no longer makes a case (the last one if none
+/// does alone): the field to name when the overridden document is refused.
+fn first_bad_override(mut doc: toml::Table, overrides: &[String]) -> String {
+    for o in overrides {
+        if apply_override(&mut doc, o).is_err()
+            || Case::deserialize(toml::Value::Table(doc.clone())).is_err()
         {
-            return Some(here);
+            return override_field(o);
         }
-        offset += l.len();
     }
-    header
+    overrides.last().map(|o| override_field(o)).unwrap_or_default()
 }
 
 /// Sets `a.b.c=value` in a document; the value is parsed as TOML, or taken as a string.
@@ -275,7 +297,10 @@ fn apply_override(doc: &mut toml::Table, assignment: &str) -> Result<(), String>
         .ok()
         .and_then(|mut t| t.remove("v"))
         .unwrap_or_else(|| toml::Value::String(raw.trim().to_string()));
-    let parts: Vec<&str> = key.trim().split('.').collect();
+    let parts: Vec<&str> = key.trim().split('.').map(str::trim).collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err("expected key=value with a dotted key, e.g. coupling.dt=1e-4".to_string());
+    }
     let (last, tables) = parts.split_last().ok_or("empty key")?;
     let mut table = doc;
     for p in tables {
@@ -307,3 +332,28 @@ pub(crate) fn require_positive(field: &str, value: f64) -> Result<(), (String, S
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod override_tests {
+    use super::*;
+
+    fn err(overrides: &[&str]) -> CaseError {
+        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        Case::parse("[coupling]\ndt = 1e-3\n", Path::new("c.toml"), &o).unwrap_err()
+    }
+
+    #[test]
+    fn a_refused_override_names_its_key() {
+        let e = err(&["coupling.dt=2e-3", "coupling.dtt=1"]);
+        assert_eq!(e.field.as_deref(), Some("coupling.dtt"), "{e}");
+        assert!(e.to_string().contains("unknown field `dtt`"), "{e}");
+        let e = err(&["nosuch=1"]);
+        assert_eq!(e.field.as_deref(), Some("nosuch"), "{e}");
+        for bad in ["=", "=1", "coupling..dt=1", ".dt=1"] {
+            let e = err(&[bad]);
+            assert!(e.field.as_deref().is_some_and(|f| !f.is_empty()), "{bad}: {e}");
+            assert!(e.to_string().contains("dotted key"), "{bad}: {e}");
+        }
+        assert_eq!(err(&[""]).field.as_deref(), Some("--set"));
+    }
+}

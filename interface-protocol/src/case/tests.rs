@@ -6,7 +6,7 @@ fn parse(text: &str) -> Result<Case, CaseError> {
 
 #[test]
 fn defaults_fill_missing_sections() {
-    let c = parse("[coupling]\nscheme = \"A6\"\ndt = 0.5\n").unwrap();
+    let c = parse("[coupling]\nscheme = \"A6\"\ndt = 0.5\nt_end = 1.0\n").unwrap();
     assert_eq!(c.coupling.scheme, Scheme::A6);
     assert_eq!(c.coupling.timeout_s, 60.0);
     assert!(c.fluid.is_none());
@@ -138,18 +138,18 @@ fn structure_errors_name_the_field_line_and_choices() {
     let (line, field, msg) = structure_error(&format!(
         "{base}[[structure.parts]]\nelement = \"quad\"\nthickness = 0.1\n"
     ));
-    assert_eq!((line, field.as_str()), (Some(5), "structure.parts.element"), "{msg}");
+    assert_eq!((line, field.as_str()), (Some(5), "structure.parts[0].element"), "{msg}");
     assert!(msg.contains("bt4") && msg.contains("mitc4") && msg.contains("tet4"), "{msg}");
     // an unknown generator lists the generators
     let (_, field, msg) =
         structure_error("[structure]\nmesh = { generator = \"disc\", radius = 1.0 }\n");
-    assert_eq!(field, "structure.mesh", "{msg}");
+    assert_eq!(field, "structure.mesh.generator", "{msg}");
     assert!(msg.contains("annulus") && msg.contains("gmsh"), "{msg}");
     // a curve that is none of the forms says what a curve is
     let (line, field, msg) = structure_error(&format!(
         "{base}[[structure.loads]]\nset = \"all\"\ndof = \"uz\"\nvalue = 1.0\ncurve = \"sine\"\n"
     ));
-    assert_eq!((line, field.as_str()), (Some(8), "structure.loads.curve"), "{msg}");
+    assert_eq!((line, field.as_str()), (Some(8), "structure.loads[0].curve"), "{msg}");
     assert!(msg.contains("ramp") && msg.contains("table"), "{msg}");
     // a table going back in time: the field of the second load, on its line
     let (line, field, msg) = structure_error(&format!(
@@ -182,4 +182,27 @@ fn structure_errors_name_the_field_line_and_choices() {
     ));
     assert_eq!((line, field.as_str()), (Some(5), "structure.arc_length"), "{msg}");
     assert!(msg.contains("0 < min <= initial <= max"), "{msg}");
+}
+
+#[test]
+fn gmsh_meshes_declare_coincident_nodes_and_load_steps_are_capped() {
+    let gmsh = |extra: &str| {
+        let text =
+            format!("[structure]\nmesh = {{ generator = \"gmsh\", file = \"m.msh\"{extra} }}\n");
+        parse(&text).map(|c| c.structure.unwrap().mesh.unwrap())
+    };
+    let coincident = |m: StructureMesh| match m {
+        StructureMesh::Gmsh { coincident_nodes, .. } => coincident_nodes,
+        m => panic!("{m:?}"),
+    };
+    assert_eq!(coincident(gmsh("").unwrap()), CoincidentNodes::Warn);
+    let allowed = gmsh(", coincident_nodes = \"allow\"").unwrap();
+    assert_eq!(coincident(allowed), CoincidentNodes::Allow);
+    let e = gmsh(", coincident_nodes = \"merge\"").unwrap_err();
+    assert!(e.message.contains("warn") && e.message.contains("allow"), "{e}");
+    // 10^10 load steps would not end in any reasonable time: refused on its line
+    let (line, field, msg) =
+        structure_error("[structure]\nintegrator = \"static\"\nsteps = 10000000000\n");
+    assert_eq!((line, field.as_str()), (Some(3), "structure.steps"), "{msg}");
+    assert!(msg.contains("more than the 1000000000"), "{msg}");
 }

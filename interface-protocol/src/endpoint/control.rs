@@ -160,15 +160,15 @@ impl Control {
         self.role
     }
 
-    /// Waits for the next command (deadline `Timeouts::wait`). The command must be answered with
-    /// `reply` before the next one is taken.
+    /// Waits for the next command (deadline `Timeouts::command`). The command must be answered
+    /// with `reply` before the next one is taken.
     pub fn next_command(&mut self) -> Result<Command, ProtocolError> {
         if self.pending.is_some() {
             return Err(ProtocolError::Mismatch(
                 "a command was taken before the previous one was answered".into(),
             ));
         }
-        let deadline = Instant::now() + self.timeouts.wait;
+        let deadline = Instant::now() + self.timeouts.command();
         let role = self.role;
         let (server, hello) = (&self.server, &self.hello);
         let request = wait_for(

@@ -59,10 +59,22 @@ impl Default for Timeouts {
     }
 }
 
+/// The most the launcher adds to a participant's wait for its next command (see
+/// [`Timeouts::command`]).
+pub const COMMAND_MARGIN: Duration = Duration::from_secs(2);
+
 impl Timeouts {
     /// `wait` from the case's `coupling.timeout_s`, `delivery` the default.
     pub fn from_secs(timeout_s: f64) -> Timeouts {
         Timeouts { wait: Duration::from_secs_f64(timeout_s), ..Timeouts::default() }
+    }
+
+    /// A participant's longest wait for its next command: `2 wait + min(wait, COMMAND_MARGIN)`.
+    /// Between two commands to one participant the launcher may await up to two replies of the
+    /// other (up to `wait` each); waiting longer than that lets the launcher, which knows whose
+    /// reply is missing, always be the one that names a silent participant.
+    pub fn command(&self) -> Duration {
+        self.wait * 2 + self.wait.min(COMMAND_MARGIN)
     }
 }
 

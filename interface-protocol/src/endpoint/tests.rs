@@ -149,8 +149,12 @@ fn waits_end_at_their_deadline_with_a_clear_error() {
     let mut s = StructureEndpoint::open(&id, HelloInfo::default(), short).unwrap();
     let e = s.read_loads(|_, l| l.len()).unwrap_err().to_string();
     assert!(e.starts_with("timed out after 0.2") && e.contains("surface/loads"), "{e}");
+    let waited = Instant::now();
     let e = s.control().next_command().unwrap_err().to_string();
     assert!(e.contains("next command to the structure"), "{e}");
+    // A command is awaited longer than a reply: 2 x 0.2 s + 0.2 s.
+    assert!(e.starts_with("timed out after 0.6"), "{e}");
+    assert!(waited.elapsed() >= short.command(), "{:?}", waited.elapsed());
     drop(s);
     link.remove_resources().unwrap();
     assert!(shm::run_files(&id).is_empty());

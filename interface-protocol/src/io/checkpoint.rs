@@ -26,6 +26,9 @@ use std::path::{Path, PathBuf};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
+mod search;
+pub use search::{latest, search, Found, Search, Skipped};
+
 const MAGIC: &[u8; 8] = b"FSICKPT\0";
 const VERSION: u32 = 1;
 /// File extension of a checkpoint part.
@@ -434,81 +437,13 @@ pub fn tag_for_step(step: u64) -> String {
     format!("step_{step:010}")
 }
 
-/// The newest complete checkpoint found by [`latest`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct Found {
-    pub tag: String,
-    pub dir: PathBuf,
-    pub step: u64,
-    pub time: f64,
-}
-
-/// The tag folder under `checkpoints_dir` with the highest step whose `parts` are all present,
-/// intact and at the same step; `None` if there is none. Incomplete or damaged folders are
-/// skipped with a warning (a run killed while writing leaves one). Candidates are ordered by the
-/// step in their file headers, so only the newest folders are read in full.
-pub fn latest(checkpoints_dir: &Path, parts: &[&str]) -> Result<Option<Found>, CheckpointError> {
-    let io_err =
-        |source| CheckpointError::Io { path: checkpoints_dir.display().to_string(), source };
-    let entries = match fs::read_dir(checkpoints_dir) {
-        Ok(e) => e,
-        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(io_err(e)),
-    };
-    let Some(first) = parts.first() else { return Ok(None) };
-    // (step from the first part's header, tag, folder)
-    let mut candidates: Vec<(u64, String, PathBuf)> = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(io_err)?;
-        let tag = entry.file_name().to_string_lossy().into_owned();
-        if check_tag(&tag).is_err() || !entry.path().is_dir() {
-            continue;
-        }
-        match read_step(&part_path(&entry.path(), first)) {
-            Some(step) => candidates.push((step, tag, entry.path())),
-            None => tracing::warn!("skipping checkpoint {tag}: part `{first}` missing or damaged"),
-        }
-    }
-    candidates.sort();
-    'tags: for (_, tag, dir) in candidates.into_iter().rev() {
-        let mut at: Option<(u64, f64)> = None;
-        for part in parts {
-            match Checkpoint::read_file(&part_path(&dir, part)) {
-                Ok(c) if at.is_none_or(|(s, _)| s == c.step) => at = Some((c.step, c.time)),
-                Ok(c) => {
-                    tracing::warn!(
-                        "skipping checkpoint {tag}: part `{part}` is at step {}",
-                        c.step
-                    );
-                    continue 'tags;
-                }
-                Err(e) => {
-                    tracing::warn!("skipping checkpoint {tag}: {e}");
-                    continue 'tags;
-                }
-            }
-        }
-        let (step, time) = at.expect("parts is not empty");
-        return Ok(Some(Found { tag, dir, step, time }));
-    }
-    Ok(None)
-}
-
-/// The step in a checkpoint file's header, without reading the rest.
-fn read_step(path: &Path) -> Option<u64> {
-    use std::io::Read;
-    let mut head = [0u8; 24];
-    fs::File::open(path).and_then(|mut f| f.read_exact(&mut head)).ok()?;
-    (head[..8] == *MAGIC).then(|| le8(&head[16..24]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use serde::Deserialize;
 
     /// Replaces a file's bytes, to damage it on purpose.
-    fn overwrite(path: &Path, bytes: &[u8]) {
+    pub(super) fn overwrite(path: &Path, bytes: &[u8]) {
         fs::write(path, bytes).unwrap();
     }
 
@@ -519,7 +454,7 @@ mod tests {
         dt: f64,
     }
 
-    fn sample(step: u64) -> Checkpoint {
+    pub(super) fn sample(step: u64) -> Checkpoint {
         let mut c = Checkpoint::new(step, step as f64 * 1e-3);
         let awkward = vec![
             0.0,
@@ -611,30 +546,6 @@ mod tests {
         }
         overwrite(&path, b"PK\x03\x04 something else entirely, long enough for a header");
         assert!(Checkpoint::read_file(&path).unwrap_err().to_string().contains("bad magic"));
-    }
-
-    #[test]
-    fn latest_skips_incomplete_and_damaged_folders() {
-        let dir = tempfile::tempdir().unwrap();
-        let ck = dir.path();
-        assert_eq!(latest(ck, &["fluid", "structure"]).unwrap(), None);
-        for step in [10, 20, 30, 40] {
-            sample(step).write(ck, &tag_for_step(step), "fluid").unwrap();
-        }
-        for step in [10, 20, 30] {
-            sample(step).write(ck, &tag_for_step(step), "structure").unwrap();
-        }
-        // 40 lacks its structure part; 30's structure part is truncated.
-        let p30 = ck.join(tag_for_step(30)).join("structure.ckpt");
-        let b = fs::read(&p30).unwrap();
-        overwrite(&p30, &b[..b.len() - 9]);
-        // A leftover temporary of an interrupted write is ignored.
-        fs::write(ck.join(tag_for_step(20)).join("fluid.ckpt.tmp.999"), b"partial").unwrap();
-        let found = latest(ck, &["fluid", "structure"]).unwrap().unwrap();
-        assert_eq!((found.tag.as_str(), found.step), ("step_0000000020", 20));
-        assert_eq!(found.dir, ck.join("step_0000000020"));
-        assert_eq!(found.time, 20.0 * 1e-3);
-        assert_eq!(latest(ck, &["fluid"]).unwrap().unwrap().step, 40);
     }
 
     #[test]

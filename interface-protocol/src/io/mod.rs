@@ -1,17 +1,20 @@
-//! What both solvers and the launcher need to report a run (DESIGN §2, §7), written once, behind
-//! the `io` feature so light participants (`rigid-structure`, foreign peers) stay small.
+//! What both solvers and the launcher need to report a run (DESIGN §2, §7), written once. The
+//! output folder, probes, checkpoints and the non-finite check are plain Rust and always built, so
+//! every participant (`rigid-structure`, `piston-fluid`, foreign peers) follows the same rules;
+//! HDF5/XDMF, the gmsh reader, the progress bar and `run.json` are behind the `io` feature, so
+//! light participants stay free of hdf5.
 //!
 //! - [`outdir`]: the run folder: creation, the refuse-to-overwrite rule (`--force`), the
 //!   `runs/<case>-<timestamp>` default and the names of the files in it.
-//! - [`xdmf`]: `<stem>.h5` + `<stem>.xdmf` field time series (XDMF 3; ParaView, meshio).
+//! - [`xdmf`] (`io`): `<stem>.h5` + `<stem>.xdmf` field time series (XDMF 3; ParaView, meshio).
 //! - [`probes`]: `probes.csv`, `structure_probes.csv` and `lines/<name>.csv`.
 //! - [`checkpoint`]: `checkpoints/<tag>/<part>.ckpt`, named arrays + metadata, checksummed;
 //!   [`checkpoint::latest`] for restarts.
 //! - [`finite`]: the first-NaN stop: where the first non-finite value is, and the error text.
-//! - [`progress`]: the terminal progress bar (step, time, dt, steps/s, ETA).
-//! - [`report`]: `run.json` (case echo, versions, counts, wall-time buckets) and the
+//! - [`progress`] (`io`): the terminal progress bar (step, time, dt, steps/s, ETA).
+//! - [`report`] (`io`): `run.json` (case echo, versions, counts, wall-time buckets) and the
 //!   [`report::Timers`] that fill it.
-//! - [`gmsh`]: the gmsh `.msh` 4.1 reader (ASCII and binary) both solvers build their meshes
+//! - [`gmsh`] (`io`): the gmsh `.msh` 4.1 reader (ASCII and binary) both solvers build their meshes
 //!   on, with errors naming the file and line.
 //!
 //! Every file a reader may open while the run goes on (`*.xdmf`, `run.json`, checkpoints, line
@@ -21,8 +24,11 @@
 //! A solver's output loop, in short:
 //!
 //! ```no_run
-//! use interface_protocol::io::{checkpoint, finite, outdir, probes, progress, report, xdmf};
+//! # #[cfg(not(feature = "io"))]
+//! # fn main() {}
+//! # #[cfg(feature = "io")]
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use interface_protocol::io::{checkpoint, finite, outdir, probes, progress, report, xdmf};
 //! let out = outdir::OutputDir::create("runs/demo", outdir::Policy::from_force(false))?;
 //! let points = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 //! let tets: Vec<u32> = vec![0, 1, 2, 3];
@@ -53,9 +59,14 @@
 pub mod atomic;
 pub mod checkpoint;
 pub mod finite;
-pub mod gmsh;
 pub mod outdir;
 pub mod probes;
+
+#[cfg(feature = "io")]
+pub mod gmsh;
+#[cfg(feature = "io")]
 pub mod progress;
+#[cfg(feature = "io")]
 pub mod report;
+#[cfg(feature = "io")]
 pub mod xdmf;

@@ -35,6 +35,15 @@ pub enum ProbeError {
     RowLength { path: PathBuf, expected: usize, got: usize, probes: usize, components: usize },
 }
 
+/// Refuses a probe name that would break the CSV header (empty, or holding `,`, `"` or a line
+/// break); participants call it while checking a case, before any file exists.
+pub fn check_probe_name(name: &str) -> Result<(), ProbeError> {
+    if name.is_empty() || name.contains([',', '"', '\n', '\r']) {
+        return Err(ProbeError::BadName(name.to_string()));
+    }
+    Ok(())
+}
+
 /// A CSV time series with a fixed header `time,<probe>.<component>,...`: rows are buffered and
 /// reach the disk at [`ProbeWriter::flush`] (call it at each field output) and on drop.
 pub struct ProbeWriter {
@@ -53,10 +62,7 @@ impl ProbeWriter {
         components: &[&str],
     ) -> Result<Self, ProbeError> {
         for name in probes {
-            let name = name.as_ref();
-            if name.is_empty() || name.contains([',', '"', '\n', '\r']) {
-                return Err(ProbeError::BadName(name.to_string()));
-            }
+            check_probe_name(name.as_ref())?;
         }
         let io_err = |source| ProbeError::Io { path: path.to_path_buf(), source };
         let mut out = BufWriter::new(File::create(path).map_err(io_err)?);
@@ -236,6 +242,10 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         assert!(matches!(ProbeWriter::fluid(dir.path(), &["a,b"]), Err(ProbeError::BadName(_))));
         assert!(matches!(ProbeWriter::fluid(dir.path(), &[""]), Err(ProbeError::BadName(_))));
+        assert!(check_probe_name("tip").is_ok());
+        let e = check_probe_name("a\nb").unwrap_err().to_string();
+        assert!(e.contains("probe name") && e.contains("line break"), "{e}");
+        assert!(!dir.path().join("probes.csv").exists(), "a refused name creates no file");
     }
 
     #[test]
