@@ -38,7 +38,12 @@ pub enum Eos {
 /// `{ kind = "stiffened_gas", gamma = 7.15, p_c = 2.89e8 }` or
 /// `{ kind = "tait", k1 = 2.07e9, k2 = 7.15, rho0 = 1000.0, p0 = 1e5 }`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    expecting = "an EOS table with a `kind` key, e.g. { kind = \"perfect_gas\", gamma = 1.4 }"
+)]
 pub enum EosSpec {
     PerfectGas {
         gamma: f64,
@@ -76,7 +81,16 @@ pub enum StateError {
     Pressure { rho: f64, p: f64, p_min: f64 },
     #[error("Tait liquid cavitates: density {rho} below {rho_cav} (pressure {p} < {p_cav})")]
     Cavitation { rho: f64, rho_cav: f64, p: f64, p_cav: f64 },
+    #[error(
+        "the Tait pressure follows from the density: ρ = {rho} gives p = {p_of_rho:e}, not {p:e}"
+    )]
+    Barotropic { rho: f64, p: f64, p_of_rho: f64 },
+    #[error("its conserved form [ρ, ρu, ρv, ρw, E] = {cons:?} is not finite (overflow)")]
+    Overflow { cons: [f64; 5] },
 }
+
+/// Relative mismatch between a given Tait pressure and `p(ρ)` that [`Eos::check_input`] accepts.
+const BAROTROPIC_TOLERANCE: f64 = 1e-6;
 
 impl TryFrom<EosSpec> for Eos {
     type Error = EosParamError;
@@ -242,6 +256,26 @@ impl Eos {
         }
         Ok(())
     }
+
+    /// Checks a state given as input (a case's initial or boundary state): [`Eos::check`], then
+    /// for a barotropic EOS that `p` is the pressure of `ρ` (the solver would silently use
+    /// `p(ρ)` instead), and that the conserved form does not overflow.
+    pub fn check_input(&self, w: &[f64; 5]) -> Result<(), StateError> {
+        self.check(w)?;
+        let [rho, .., p] = *w;
+        if self.is_barotropic() {
+            let p_of_rho = self.tait_pressure(rho);
+            let scale = p.abs().max(p_of_rho.abs()).max(self.stiffness().1);
+            if (p - p_of_rho).abs() > BAROTROPIC_TOLERANCE * scale {
+                return Err(StateError::Barotropic { rho, p, p_of_rho });
+            }
+        }
+        let cons = self.prim_to_cons(w);
+        if cons.iter().any(|q| !q.is_finite()) {
+            return Err(StateError::Overflow { cons });
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -345,6 +379,27 @@ mod tests {
             other => panic!("expected cavitation, got {other:?}"),
         }
         assert!(gas.check(&[1.0, f64::NAN, 0.0, 0.0, 1.0]).is_err());
+    }
+
+    #[test]
+    fn input_states_must_mean_what_they_say() {
+        let tait = Eos::tait(2.07e9, 7.15, 1000.0, 1e5);
+        assert_eq!(tait.check_input(&[1000.0, 0.0, 0.0, 0.0, 1e5]), Ok(()));
+        let p = tait.tait_pressure(1100.0);
+        assert_eq!(tait.check_input(&[1100.0, 1.0, 0.0, 0.0, p]), Ok(()));
+        // A pressure the density does not give would be replaced by p(ρ) without a word.
+        let e = tait.check_input(&[1000.0, 0.0, 0.0, 0.0, 5e5]).unwrap_err();
+        assert!(matches!(e, StateError::Barotropic { p_of_rho, .. } if p_of_rho == 1e5), "{e}");
+        assert!(e.to_string().contains("gives p = 1e5, not 5e5"), "{e}");
+        // A speed whose kinetic energy overflows passes `check` but not `check_input`.
+        let gas = Eos::PerfectGas { gamma: 1.4 };
+        let fast = [1.0, 1e200, 0.0, 0.0, 1.0];
+        assert_eq!(gas.check(&fast), Ok(()));
+        assert!(matches!(gas.check_input(&fast), Err(StateError::Overflow { .. })));
+        assert_eq!(
+            gas.check_input(&[1.0, 0.0, 0.0, 0.0, 0.0]),
+            gas.check(&[1.0, 0.0, 0.0, 0.0, 0.0])
+        );
     }
 
     #[test]

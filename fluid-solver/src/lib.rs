@@ -4,17 +4,20 @@
 //!
 //! Modules follow the discretisation: `eos` -> `mesh` (geometry and connectivity only, never
 //! solver state) -> `riemann`, `flux`, `reconstruct`, `bc` -> `state`, `initial` ->
-//! `semidiscretization` (the residual) -> `time` -> `solver` (the run loop) with `output`,
-//! `probes` -> `couple` (the coupling participant). Must not touch: the structure, the IPC
+//! `semidiscretization` (the residual) -> `time` -> `setup` (everything before the first step,
+//! with `memory`) -> `solver` (the run loop) with `output`, `probes` -> `couple` (the coupling
+//! participant) and `check` (`fluid-solver check`). Must not touch: the structure, the IPC
 //! transport (it talks to the structure only through `interface-protocol` endpoints).
 #![deny(unsafe_op_in_unsafe_fn)]
 
 pub mod bc;
 pub mod bench;
+pub mod check;
 pub mod couple;
 pub mod eos;
 pub mod flux;
 pub mod initial;
+pub mod memory;
 pub mod mesh;
 pub mod output;
 pub mod probes;

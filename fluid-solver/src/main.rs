@@ -1,9 +1,9 @@
 //! `fluid-solver`: runs a case alone (`run`) or as the fluid of a coupled run (`run --couple`),
-//! or measures its speed (`bench`).
+//! checks a case without running it (`check`), or measures its speed (`bench`).
 
 use clap::{Parser, Subcommand};
-use fluid_solver::{bench, couple, solver};
-use interface_protocol::cli::RunArgs;
+use fluid_solver::{bench, check, couple, solver};
+use interface_protocol::cli::{CheckArgs, RunArgs};
 use interface_protocol::io::outdir;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -29,9 +29,12 @@ enum Command {
         /// Continue from the newest checkpoint of this previous run folder.
         #[arg(long)]
         restart: Option<PathBuf>,
-        /// Overwrite the previous run's files in the output folder.
-        #[arg(long)]
-        force: bool,
+    },
+    /// Set a case up as `run` would (mesh, boundaries, EOS, states, probes, lines, time step),
+    /// print a summary and exit without running or writing anything.
+    Check {
+        #[command(flatten)]
+        args: CheckArgs,
     },
     /// Measure node-steps per second per core of RK2 + MUSCL + Roe on a tet box; prints JSON.
     Bench {
@@ -54,7 +57,15 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { args, restart, force } => run(&args, restart, force),
+        Command::Run { args, restart } => run(&args, restart),
+        Command::Check { args } => args.load_case().map_err(anyhow::Error::from).and_then(|case| {
+            let checked = check::check(&case)?;
+            print!("{}", checked.summary);
+            for w in &checked.warnings {
+                eprintln!("fluid-solver: warning: {w}");
+            }
+            Ok(())
+        }),
         Command::Bench { nodes, steps, threads, dump_edges } => {
             bench::run(nodes, steps, &threads, dump_edges.as_deref()).map(|report| {
                 println!("{}", serde_json::to_string_pretty(&report).expect("JSON"));
@@ -70,12 +81,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(args: &RunArgs, restart: Option<PathBuf>, force: bool) -> anyhow::Result<()> {
+fn run(args: &RunArgs, restart: Option<PathBuf>) -> anyhow::Result<()> {
     let case = args.load_case()?;
     let text = std::fs::read_to_string(&args.case)?;
     let out = args.out_dir(&case, || outdir::default_run_dir(&args.case, SystemTime::now()));
     let quiet = args.quiet;
-    let opts = solver::RunOptions { out: out.clone(), quiet, restart, force };
+    let opts = solver::RunOptions { out: out.clone(), quiet, restart, force: args.force };
     if let Some(run_id) = &args.couple {
         return couple::run(&case, &text, opts, run_id);
     }

@@ -1,10 +1,75 @@
 //! Probes and lines: the fluid state sampled at points (`probes.csv`) and along straight lines
 //! (`lines/<name>.csv`). A sample takes the state of the node nearest to the point (exact at
-//! nodes; interpolation inside cells is not done).
+//! nodes; interpolation inside cells is not done). [`place`] puts a case's probes and lines on
+//! the mesh and refuses any point outside it.
 
 use crate::mesh::geometry::{add, dot, norm, scale, sub};
-use crate::mesh::Mesh;
+use crate::mesh::{locate, Mesh};
+use crate::time::reached;
+use interface_protocol::case::{FluidLine, FluidProbe};
 use interface_protocol::io::probes::LinePoint;
+
+/// A case's probes and lines on the mesh.
+#[derive(Debug, Clone)]
+pub struct Placed {
+    /// The node of each probe.
+    pub probe_nodes: Vec<usize>,
+    pub lines: Vec<Line>,
+}
+
+/// Places `probes` (`fluid.probes`) and `lines` (`fluid.lines`) on `mesh`. Every probe and every
+/// sample point of a line must lie in a cell of the mesh; an error names the first that does
+/// not by its key (`fluid.probes[2].at`, `fluid.lines[0].to`, or the sample point of a line).
+pub fn place(
+    mesh: &Mesh,
+    probes: &[FluidProbe],
+    asked: &[FluidLine],
+) -> Result<Placed, (String, String)> {
+    let lines: Vec<Line> =
+        asked.iter().map(|l| Line::new(mesh, &l.name, l.from, l.to, l.points, &l.times)).collect();
+    let points: Vec<[f64; 3]> = probes
+        .iter()
+        .map(|p| p.at)
+        .chain(lines.iter().flat_map(|l| l.points.iter().copied()))
+        .collect();
+    let inside = locate::inside(mesh, &points);
+    let outside = |field: String, what: String, x: [f64; 3]| {
+        let (lo, hi) = mesh.bounding_box();
+        Err((
+            field,
+            format!(
+                "{what}{x:?} lies outside the fluid mesh (in none of its cells; its bounding box \
+                 is {lo:?} to {hi:?})"
+            ),
+        ))
+    };
+    for (k, p) in probes.iter().enumerate() {
+        if !inside[k] {
+            return outside(format!("fluid.probes[{k}].at"), String::new(), p.at);
+        }
+    }
+    let mut first = probes.len();
+    for (k, line) in lines.iter().enumerate() {
+        let n = line.points.len();
+        // The ends first: when one is outside, it is the one to name.
+        if let Some(j) = [0, n - 1].into_iter().chain(1..n - 1).find(|&j| !inside[first + j]) {
+            return match j {
+                0 => outside(format!("fluid.lines[{k}].from"), String::new(), asked[k].from),
+                j if j == n - 1 => {
+                    outside(format!("fluid.lines[{k}].to"), String::new(), asked[k].to)
+                }
+                j => outside(
+                    format!("fluid.lines[{k}]"),
+                    format!("sample point {j} of {n} of line `{}`, at ", line.name),
+                    line.points[j],
+                ),
+            };
+        }
+        first += n;
+    }
+    let probe_nodes = probes.iter().map(|p| nearest_node(mesh, p.at)).collect();
+    Ok(Placed { probe_nodes, lines })
+}
 
 /// The node nearest to `x`.
 pub fn nearest_node(mesh: &Mesh, x: [f64; 3]) -> usize {
@@ -25,7 +90,7 @@ pub struct Line {
     pub name: String,
     pub points: Vec<[f64; 3]>,
     pub nodes: Vec<usize>,
-    /// Times still to write, ascending.
+    /// Times still to write, ascending (the run lands a step on each).
     pub pending: Vec<f64>,
 }
 
@@ -44,6 +109,11 @@ impl Line {
         let mut pending = times.to_vec();
         pending.sort_by(f64::total_cmp);
         Line { name: name.to_string(), points, nodes, pending }
+    }
+
+    /// Whether the next time to write is reached at `t`.
+    pub fn due(&self, t: f64) -> bool {
+        self.pending.first().is_some_and(|&lt| reached(t, lt))
     }
 
     /// The samples of the current state.

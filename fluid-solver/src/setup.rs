@@ -1,35 +1,61 @@
-//! From a case's `[fluid]` section to a ready problem: mesh, EOS, scheme, boundary conditions,
-//! initial state, probes and lines. Errors name the case field (`fluid.<...>`) and what was
-//! expected.
+//! From a case's `[fluid]` section to a ready problem: everything a run does before its first
+//! step, shared by `run` (alone and coupled) and `check` so that they cannot drift. The mesh
+//! (refused before it is built if it cannot fit in memory), EOS, scheme, boundary conditions,
+//! initial state (every state admissible for the EOS, every region holding a node), probes and
+//! lines (inside the mesh; a line time after the end is a warning), and the initial CFL step (a run that would
+//! take more than `resources::MAX_STEPS` steps is refused). Errors name the case field
+//! (`fluid.<...>`) and what was expected.
 
 use crate::bc::BoundaryCondition;
 use crate::eos::Eos;
 use crate::flux::FluxScheme;
 use crate::initial::InitialCondition;
+use crate::memory;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec};
 use crate::mesh::{gmsh, Mesh};
+use crate::probes::{self, Placed};
 use crate::reconstruct::limiter::Limiter;
 use crate::semidiscretization::{Numerics, Semidiscretization};
-use crate::state::State;
-use crate::time::TimeStepping;
-use interface_protocol::case::{
-    BoxShape, Case, FluidBoundary, FluidLine, FluidProbe, FluidSection,
-};
+use crate::state::{State, Workspace};
+use crate::time::cfl::stable_time_step;
+use crate::time::{reached, TimeStepping};
+use interface_protocol::case::{BoxShape, Case, FluidBoundary, FluidProbe, FluidSection};
+use interface_protocol::resources;
 
-/// Everything a stand-alone run needs.
+/// Whether the fluid runs alone or as a participant of a coupled run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Alone: creates its output folder, draws a progress bar, stops at `fluid.time.t_end` or
+    /// `max_steps`, checkpoints every `output.checkpoint_every` steps and writes `run.json`.
+    Alone,
+    /// Coupled (DESIGN §7): the launcher made the output folder, drives the time with its
+    /// `Advance` commands to `coupling.t_end`, asks for checkpoints and writes `run.json` itself;
+    /// `[fluid.time]` is not used.
+    Coupled,
+}
+
+/// Everything a run needs.
 #[derive(Debug, Clone)]
 pub struct Problem {
     pub semi: Semidiscretization,
     pub initial: State,
     pub stepping: TimeStepping,
+    /// The end of the run: `fluid.time.t_end` alone, `coupling.t_end` coupled.
     pub t_end: f64,
+    /// `fluid.time.max_steps` (alone only).
     pub max_steps: Option<u64>,
     pub probes: Vec<FluidProbe>,
-    pub lines: Vec<FluidLine>,
+    /// The probes and lines on the mesh.
+    pub placed: Placed,
+    /// The first step: the CFL step of the initial state.
+    pub dt_initial: f64,
+    /// What the case asks for that the run will not do (e.g. a line time after the end).
+    pub warnings: Vec<String>,
 }
 
+/// An error naming the case file, the line of `field` and the field.
 fn field_error(case: &Case, field: &str, message: impl std::fmt::Display) -> anyhow::Error {
-    anyhow::anyhow!("{}: field `{field}`: {message}", case.source.path.display())
+    case.field_error(field, message.to_string()).into()
 }
 
 /// The `[fluid]` section, or an error saying it is needed.
@@ -39,28 +65,54 @@ pub fn section(case: &Case) -> anyhow::Result<&FluidSection> {
         .ok_or_else(|| field_error(case, "fluid", "fluid-solver needs a [fluid] section"))
 }
 
-/// Builds the mesh of `[fluid.mesh]`.
+/// Builds the mesh of `[fluid.mesh]`, first refusing one this machine cannot hold.
 pub fn mesh(case: &Case) -> anyhow::Result<Mesh> {
     let f = section(case)?;
     let m = f.mesh.as_ref().ok_or_else(|| {
         field_error(case, "fluid.mesh", "missing: give `box = {...}` or `file = \"mesh.msh\"`")
     })?;
     let raw = match (&m.box_mesh, &m.file) {
-        (Some(b), _) => BoxSpec {
-            lo: b.lo,
-            hi: b.hi,
-            cells: b.cells,
-            grading: b.grading,
-            shape: match b.shape {
-                BoxShape::Hex => BoxCells::Hex,
-                BoxShape::Tet => BoxCells::Tet,
-            },
+        (Some(b), _) => {
+            let key = "fluid.mesh.box.cells";
+            let per_hex = match b.shape {
+                BoxShape::Hex => 1.0,
+                BoxShape::Tet => 6.0,
+            };
+            let nodes: f64 = b.cells.iter().map(|&c| c as f64 + 1.0).product();
+            let cells: f64 = per_hex * b.cells.iter().map(|&c| c as f64).product::<f64>();
+            let what = format!("the fluid mesh of `{key} = {:?}`", b.cells);
+            memory::ensure_fits(&what, nodes, cells).map_err(|e| field_error(case, key, e))?;
+            if nodes > u32::MAX as f64 {
+                return Err(field_error(
+                    case,
+                    key,
+                    format!(
+                        "{:?} makes {nodes:.3e} nodes, more than the {} a fluid mesh numbers",
+                        b.cells,
+                        u32::MAX
+                    ),
+                ));
+            }
+            BoxSpec {
+                lo: b.lo,
+                hi: b.hi,
+                cells: b.cells,
+                grading: b.grading,
+                shape: match b.shape {
+                    BoxShape::Hex => BoxCells::Hex,
+                    BoxShape::Tet => BoxCells::Tet,
+                },
+            }
+            .raw()
+            .map_err(|e| field_error(case, "fluid.mesh.box", e))?
         }
-        .raw()
-        .map_err(|e| field_error(case, "fluid.mesh.box", e))?,
         (None, Some(file)) => {
             let path = case.dir().join(file);
-            gmsh::read(&path).map_err(|e| field_error(case, "fluid.mesh.file", e))?
+            let raw = gmsh::read(&path).map_err(|e| field_error(case, "fluid.mesh.file", e))?;
+            let what = format!("the fluid mesh of `fluid.mesh.file = {file:?}`");
+            memory::ensure_fits(&what, raw.coords.len() as f64, raw.cells.len() as f64)
+                .map_err(|e| field_error(case, "fluid.mesh.file", e))?;
+            raw
         }
         (None, None) => {
             return Err(field_error(
@@ -100,8 +152,8 @@ pub fn numerics(case: &Case) -> anyhow::Result<Numerics> {
     Ok(Numerics { flux, limiter })
 }
 
-/// Builds the whole problem.
-pub fn problem(case: &Case) -> anyhow::Result<Problem> {
+/// Builds the whole problem for a run in `mode`: everything before the first step.
+pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
     let f = section(case)?;
     let mesh = mesh(case)?;
     let eos = eos(case)?;
@@ -119,7 +171,8 @@ pub fn problem(case: &Case) -> anyhow::Result<Problem> {
             ));
         }
         let check = |w: &[f64; 5]| {
-            eos.check(w).map_err(|e| field_error(case, &format!("fluid.boundary.{name}.state"), e))
+            eos.check_input(w)
+                .map_err(|e| field_error(case, &format!("fluid.boundary.{name}.state"), e))
         };
         let bc = match *b {
             FluidBoundary::SlipWall => BoundaryCondition::SlipWall,
@@ -132,7 +185,21 @@ pub fn problem(case: &Case) -> anyhow::Result<Problem> {
                 check(&state)?;
                 BoundaryCondition::Inflow { state }
             }
-            FluidBoundary::Outflow { pressure } => BoundaryCondition::Outflow { pressure },
+            FluidBoundary::Outflow { pressure } => {
+                let p_min = eos.min_pressure();
+                let admitted =
+                    if eos.is_barotropic() { pressure >= p_min } else { pressure > p_min };
+                if !admitted {
+                    return Err(field_error(
+                        case,
+                        &format!("fluid.boundary.{name}.pressure"),
+                        format!(
+                            "{pressure} is at or below the lowest pressure {p_min} the EOS admits"
+                        ),
+                    ));
+                }
+                BoundaryCondition::Outflow { pressure }
+            }
         };
         conditions.push((name.clone(), bc));
     }
@@ -143,26 +210,69 @@ pub fn problem(case: &Case) -> anyhow::Result<Problem> {
         background: init.state,
         regions: init.regions.iter().map(|r| (r.region, r.state)).collect(),
     };
-    let initial = ic
-        .state(&mesh, &eos)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", case.source.path.display()))?;
+    let initial =
+        ic.state(&mesh, &eos).map_err(|(field, message)| field_error(case, &field, message))?;
+    let placed = probes::place(&mesh, &f.probes, &f.lines)
+        .map_err(|(field, message)| field_error(case, &field, message))?;
     let semi = Semidiscretization::new(mesh, eos, numerics, &conditions)
         .map_err(|e| field_error(case, "fluid.boundary", e))?;
-    let time =
-        f.time.as_ref().ok_or_else(|| field_error(case, "fluid.time", "missing: give `t_end`"))?;
+    let (t_end, end_key, max_steps) = match mode {
+        Mode::Alone => {
+            let time = f.time.as_ref().ok_or_else(|| {
+                field_error(case, "fluid.time", "missing: give `t_end` (a run alone needs it)")
+            })?;
+            (time.t_end, "fluid.time.t_end", time.max_steps)
+        }
+        Mode::Coupled => (case.coupling.t_end, "coupling.t_end", None),
+    };
+    // A run shortened with `--set` may end before a sample it asks for: said, not refused.
+    let mut warnings = Vec::new();
+    for (k, l) in f.lines.iter().enumerate() {
+        for (j, &lt) in l.times.iter().enumerate().filter(|(_, &lt)| !reached(t_end, lt)) {
+            let message = format!(
+                "{lt} is after the end of the run ({end_key} = {t_end}): that sample will not be \
+                 written"
+            );
+            warnings.push(
+                case.field_error(&format!("fluid.lines[{k}].times[{j}]"), message).to_string(),
+            );
+        }
+    }
     let cfl = f.numerics.cfl;
     let stepping = if f.numerics.local_time_step {
         TimeStepping::Local { cfl }
     } else {
         TimeStepping::Global { cfl }
     };
+    let dt_initial = {
+        let mut ws = Workspace::new(semi.mesh.n_nodes());
+        cfl * stable_time_step(&semi, &initial.cons, &mut ws)?
+    };
+    if max_steps.is_none() && resources::step_count(end_key, t_end, dt_initial).is_err() {
+        let bound = match mode {
+            Mode::Alone => ", or bound the run with fluid.time.max_steps",
+            Mode::Coupled => "",
+        };
+        return Err(field_error(
+            case,
+            end_key,
+            format!(
+                "{end_key} = {t_end:e} over the initial CFL step {dt_initial:.3e} is about {:.3e} \
+                 steps, more than the {} one run may take; check the end time{bound}",
+                t_end / dt_initial,
+                resources::MAX_STEPS
+            ),
+        ));
+    }
     Ok(Problem {
         semi,
         initial,
         stepping,
-        t_end: time.t_end,
-        max_steps: time.max_steps,
+        t_end,
+        max_steps,
         probes: f.probes.clone(),
-        lines: f.lines.clone(),
+        placed,
+        dt_initial,
+        warnings,
     })
 }

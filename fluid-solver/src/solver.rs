@@ -1,18 +1,24 @@
 //! The run loop (DESIGN §7): [`FluidRun`] marches a case with RK2 in CFL steps, writing probes,
 //! lines, the field time series and checkpoints. [`run`] drives it alone to its end time and
 //! writes `run.json`; [`crate::couple`] drives it from the coupling commands. Restarts from a
-//! checkpoint; stops at the first invalid or non-finite state naming node, time and values,
+//! checkpoint; checks after every step (alone and coupled) that the state is valid and finite,
+//! and stops at the first step that breaks either, naming node, field, time and values and
 //! keeping the last good checkpoint.
 //!
+//! Requested output times (the `times` of the lines) are landed on exactly: the step that would
+//! pass the next one is shortened to end on it, as is the step that would pass the target time,
+//! and the CFL step resumes after it.
+//!
 //! A restarted run is bitwise identical to an uninterrupted one: the state is the conserved
-//! array plus `(step, t)`, and the time step depends only on them and on the target time.
+//! array plus `(step, t)`, and the time step depends only on them, on the target time and on the
+//! output times after `t`.
 
 use crate::output;
-use crate::probes::{nearest_node, Line};
+use crate::probes::{Line, Placed};
 use crate::semidiscretization::Semidiscretization;
 use crate::setup::{self, Problem};
 use crate::state::{State, Workspace};
-use crate::time::{rk2_step, TimeStepping};
+use crate::time::{reached, rk2_step, TimeStepping};
 use anyhow::Context;
 use interface_protocol::case::Case;
 use interface_protocol::io::checkpoint::{self, Checkpoint};
@@ -63,16 +69,7 @@ pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State,
     Ok((State { cons }, ck.step, ck.time))
 }
 
-/// Whether the fluid runs alone or as a participant of a coupled run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    /// Alone: creates its output folder, draws a progress bar, stops at `fluid.time.t_end` or
-    /// `max_steps`, checkpoints every `output.checkpoint_every` steps and writes `run.json`.
-    Alone,
-    /// Coupled (DESIGN §7): the launcher made the output folder, drives the time with its
-    /// `Advance` commands, asks for checkpoints and writes `run.json` itself.
-    Coupled,
-}
+pub use crate::setup::Mode;
 
 /// Where an advance ended.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,29 +117,33 @@ impl<'a> FluidRun<'a> {
         mode: Mode,
     ) -> anyhow::Result<FluidRun<'a>> {
         let wall = Instant::now();
-        let problem = setup::problem(case)?;
+        let problem = setup::problem(case, mode)?;
+        for w in &problem.warnings {
+            eprintln!("fluid-solver: warning: {w}");
+        }
         let policy = match mode {
             Mode::Alone => Policy::from_force(opts.force),
             Mode::Coupled => Policy::Existing,
         };
         let out = OutputDir::create(&opts.out, policy)?;
-        let Problem { semi, initial, stepping, t_end, max_steps, probes, lines } = problem;
+        let Problem { semi, initial, stepping, t_end, max_steps, probes, placed, .. } = problem;
+        let Placed { probe_nodes, mut lines } = placed;
         let (state, step, t) = match &opts.restart {
             Some(dir) => read_checkpoint(dir, semi.mesh.n_nodes())?,
             None => (initial, 0, 0.0),
         };
+        if opts.restart.is_some() {
+            // Written before the checkpoint was taken.
+            for line in &mut lines {
+                line.pending.retain(|&lt| !reached(t, lt));
+            }
+        }
         let mut ws = Workspace::new(semi.mesh.n_nodes());
         semi.primitives(&state.cons, &mut ws)?;
 
         let mut fields = output::create_writer(out.path(), &semi.mesh)?;
         let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
-        let probe_nodes: Vec<usize> =
-            probes.iter().map(|p| nearest_node(&semi.mesh, p.at)).collect();
         let probe_csv = ProbeWriter::fluid(out.path(), &names)?;
-        let lines: Vec<Line> = lines
-            .iter()
-            .map(|l| Line::new(&semi.mesh, &l.name, l.from, l.to, l.points, &l.times))
-            .collect();
         output::write_fields(&mut fields, &semi.eos, t, &ws.prim)?;
         let bar = Progress::new(t_end, opts.quiet || mode == Mode::Coupled);
         let mut run = FluidRun {
@@ -169,6 +170,8 @@ impl<'a> FluidRun<'a> {
             status: Ok(()),
         };
         run.write_probes()?;
+        // Lines asked for at the start time.
+        run.write_due_lines()?;
         Ok(run)
     }
 
@@ -194,10 +197,33 @@ impl<'a> FluidRun<'a> {
         Ok(())
     }
 
-    /// Advances to `t_target` in RK2 steps of the CFL step, the last one clipped to land on
-    /// `t_target`, writing the outputs of every step; stops early after `fluid.time.max_steps`
-    /// steps (stand-alone runs only). A failed step keeps the last good state as a checkpoint and
-    /// returns the error naming the step, time, node and values; the run then only finishes.
+    /// The time the next step must not pass: `t_target` or the next line time before it.
+    fn next_stop(&self, t_target: f64) -> f64 {
+        self.lines.iter().filter_map(|l| l.pending.first().copied()).fold(t_target, f64::min)
+    }
+
+    /// Writes the lines whose next time is reached (from `ws.prim`), each once, in a file named
+    /// for the time.
+    fn write_due_lines(&mut self) -> anyhow::Result<()> {
+        let t = self.t;
+        for line in &mut self.lines {
+            if line.due(t) {
+                while line.due(t) {
+                    line.pending.remove(0);
+                }
+                let name = format!("{}_t{t:.6e}", line.name);
+                write_line_sample(&self.out.lines()?, &name, &line.sample(&self.ws.prim))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Advances to `t_target` in RK2 steps of the CFL step, shortened to land exactly on each
+    /// line time on the way and on `t_target`, writing the outputs of every step; stops early
+    /// after `fluid.time.max_steps` steps (stand-alone runs only). Every step's state is checked
+    /// valid and finite; a failed step keeps the last good state (alone, as a checkpoint) and
+    /// returns the error naming the step, time, node, field and values; the run then only
+    /// finishes.
     pub fn advance_to(&mut self, t_target: f64) -> anyhow::Result<Reached> {
         if let Err(e) = &self.status {
             anyhow::bail!("{e}");
@@ -207,17 +233,21 @@ impl<'a> FluidRun<'a> {
             Mode::Coupled => None,
         };
         let every = &self.case.output;
-        while self.t < t_target * (1.0 - 1e-12) && limit.is_none_or(|m| self.step < m) {
+        while !reached(self.t, t_target) && limit.is_none_or(|m| self.step < m) {
             let (step, t) = (self.step, self.t);
+            let stop = self.next_stop(t_target);
             let start = Instant::now();
             let result =
-                rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, t_target - t);
+                rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, stop - t);
             self.timers.add_since(bucket::RESIDUAL, start);
             let dt = match result {
                 Ok(dt) => dt,
                 Err(e) => {
-                    // The state is unchanged by a failed step: keep it as the last good checkpoint.
-                    self.write_checkpoint(&checkpoint::tag_for_step(step))?;
+                    // The state is unchanged by a failed step: keep it as the last good
+                    // checkpoint (coupled, the launcher names and asks for checkpoints).
+                    if self.mode == Mode::Alone {
+                        self.write_checkpoint(&checkpoint::tag_for_step(step))?;
+                    }
                     return self.fail(format!("stopped at step {}, t = {t:e}: {e}", step + 1));
                 }
             };
@@ -232,32 +262,25 @@ impl<'a> FluidRun<'a> {
                     self.state.cons[node]
                 ));
             }
-            self.t += dt;
+            // A shortened step ends exactly on its stop, not at a rounded `t + dt`.
+            self.t = if dt >= stop - t { stop } else { t + dt };
             self.step += 1;
             let (step, t) = (self.step, self.t);
             let start = Instant::now();
+            let want_probes = step % every.probes_every == 0;
             let want_fields = every.fields_every > 0 && step % every.fields_every == 0;
-            let want_lines =
-                self.lines.iter().any(|l| l.pending.first().is_some_and(|&lt| t >= lt));
-            if step % every.probes_every == 0 || want_fields || want_lines {
+            let want_lines = self.lines.iter().any(|l| l.due(t));
+            if want_probes || want_fields || want_lines {
                 self.semi.primitives(&self.state.cons, &mut self.ws)?;
             }
-            if step % every.probes_every == 0 {
+            if want_probes {
                 self.write_probes()?;
             }
             if want_fields {
                 output::write_fields(&mut self.fields, &self.semi.eos, t, &self.ws.prim)?;
                 self.last_fields_step = step;
             }
-            for line in &mut self.lines {
-                if line.pending.first().is_some_and(|&lt| t >= lt) {
-                    while line.pending.first().is_some_and(|&lt| t >= lt) {
-                        line.pending.remove(0);
-                    }
-                    let name = format!("{}_t{t:.6e}", line.name);
-                    write_line_sample(&self.out.lines()?, &name, &line.sample(&self.ws.prim))?;
-                }
-            }
+            self.write_due_lines()?;
             if self.mode == Mode::Alone
                 && every.checkpoint_every > 0
                 && step % every.checkpoint_every == 0

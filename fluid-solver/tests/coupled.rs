@@ -276,3 +276,82 @@ fn a_structure_with_a_wet_surface_is_refused_at_init() {
     assert!(stderr.contains(&no_embedded_boundary(4)), "{stderr}");
     assert!(out.join("run.json").is_file());
 }
+
+/// A coupled fluid checks its state every step as the fluid alone does: two streams leaving each
+/// other at Mach 6.7 pull the pressure negative a few steps in, and the `Advance` that meets it
+/// is answered `Failed` (a solver failure) naming the step, the node, the field and its values.
+#[test]
+fn a_coupled_step_that_goes_bad_is_answered_failed_naming_node_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let state = |u: f64| format!("[1.0, {u}, 0.0, 0.0, 0.1]");
+    let separating = FLUID
+        .replace(
+            "state = [1.0, 0.0, 0.0, 0.0, 1.0]\nregions = [\n  { region = { shape = \"half_space\", point = [0.3, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }, state = [0.125, 0.0, 0.0, 0.0, 0.1] },",
+            &format!(
+                "state = {}\nregions = [\n  {{ region = {{ shape = \"half_space\", point = [0.5, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }}, state = {} }},",
+                state(-2.5),
+                state(2.5)
+            ),
+        )
+        .replace("xmin = { kind = \"far_field\", state = [1.0, 0.0, 0.0, 0.0, 1.0] }", &format!("xmin = {{ kind = \"far_field\", state = {} }}", state(-2.5)))
+        .replace("xmax = { kind = \"far_field\", state = [0.125, 0.0, 0.0, 0.0, 0.1] }", &format!("xmax = {{ kind = \"far_field\", state = {} }}", state(2.5)))
+        .replace("cfl = 0.9", "cfl = 0.3");
+    assert_eq!(separating.matches("2.5").count(), 4, "{separating}");
+    let case_path = write_case(dir.path(), &separating);
+    let case = Case::load(&case_path, &[]).unwrap();
+    let coupled = dir.path().join("coupled");
+    std::fs::create_dir(&coupled).unwrap();
+    let id = run_id("bad");
+    let timeouts = Timeouts::from_secs(10.0);
+    let mut link = LauncherLink::open(&id, timeouts).unwrap();
+    let fluid = Process::new(bin("fluid-solver"))
+        .arg("run")
+        .arg(&case_path)
+        .args(["--couple", &id, "--quiet", "--out"])
+        .arg(&coupled)
+        .env(LAUNCHER_PID_ENV, std::process::id().to_string())
+        .stdin(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
+    let mut structure = StructureEndpoint::open(&id, info, timeouts).unwrap();
+    let soon = Instant::now() + Duration::from_secs(10);
+    let f = link.wait_hello(Role::Fluid, soon).unwrap();
+    let s = link.wait_hello(Role::Structure, soon).unwrap();
+    LauncherLink::check(&f, &s, case.hash()).unwrap();
+    structure.publish_topology(header(0, 0.0), 0, |_| ()).unwrap();
+    structure.publish_kinematics(header(0, 0.0), 0, |_| ()).unwrap();
+    expect_reply(&mut link, &Command::init(), reply_kind::READY);
+    structure.read_loads(|_, _| ()).unwrap();
+    let mut failed = None;
+    for (n, w) in TIMES.windows(2).enumerate() {
+        let n = n as u64;
+        structure.publish_kinematics(header(n, w[1]), 0, |_| ()).unwrap();
+        link.send(Role::Fluid, &Command::advance(n, w[0], w[1], scheme_phase::NONE)).unwrap();
+        let reply = link.wait_reply(Role::Fluid, Instant::now() + Duration::from_secs(10)).unwrap();
+        if reply.kind == reply_kind::FAILED {
+            failed = Some(reply);
+            break;
+        }
+        assert_eq!(reply.kind, reply_kind::DONE, "{}", reply.message_str());
+        structure.read_loads(|_, _| ()).unwrap();
+    }
+    let failed = failed.expect("a step of the separating streams fails");
+    let msg = failed.message_str();
+    println!("{msg}");
+    assert_eq!(failed.code, failure_code::SOLVER, "{msg}");
+    assert!(
+        msg.contains("stopped at step ") && msg.contains("invalid fluid state at node "),
+        "{msg}"
+    );
+    assert!(msg.contains("pressure ") && msg.contains("primitive [ρ, u, v, w, p] = ["), "{msg}");
+    link.send(Role::Fluid, &Command::finish()).unwrap();
+    let _ = link.wait_reply(Role::Fluid, Instant::now() + Duration::from_secs(10));
+    let out = fluid.wait_with_output().unwrap();
+    drop(structure);
+    link.remove_resources().unwrap();
+    assert!(!coupled.join("run.json").exists(), "run.json is the launcher's");
+    // Coupled, checkpoints are the launcher's to name: the failing fluid writes none of its own.
+    assert!(!coupled.join("checkpoints").exists(), "{}", String::from_utf8_lossy(&out.stderr));
+}

@@ -7,7 +7,7 @@
 
 use fluid_solver::eos::{Eos, StateError};
 use fluid_solver::semidiscretization::FluidError;
-use fluid_solver::setup;
+use fluid_solver::setup::{self, Mode};
 use fluid_solver::solver::{self, read_checkpoint, RunOptions};
 use fluid_solver::state::Workspace;
 use fluid_solver::time::rk2_step;
@@ -67,7 +67,7 @@ fn stops_naming_node_time_and_values(out: &Path, overrides: &[String]) -> (Strin
     // A few steps in, so that the time is that of the failing step, not the start.
     assert!(step > 1 && time > 0.0, "{msg}");
 
-    let problem = setup::problem(&case).unwrap();
+    let problem = setup::problem(&case, Mode::Alone).unwrap();
     let semi = &problem.semi;
     let (mut state, at_step, at_time) = read_checkpoint(out, semi.mesh.n_nodes()).unwrap();
     assert_eq!((at_step + 1, at_time.to_bits()), (step, time.to_bits()), "{msg}");
@@ -113,7 +113,7 @@ fn tait_water_below_cavitation_stops_the_run_naming_node_time_and_values() {
 fn non_positive_density_is_reported_with_its_node_and_values() {
     let path = case_path();
     let case = Case::load(&path, &["fluid.mesh.box.cells=[20,1,1]".to_string()]).unwrap();
-    let problem = setup::problem(&case).unwrap();
+    let problem = setup::problem(&case, Mode::Alone).unwrap();
     let semi = &problem.semi;
     let eos = semi.eos;
     assert!(matches!(eos, Eos::PerfectGas { .. }));

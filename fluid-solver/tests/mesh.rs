@@ -196,6 +196,14 @@ fn bad_meshes_give_named_errors() {
     assert!(matches!(e, MeshError::BadCell { cell: 3, .. }), "{e}");
     assert!(e.to_string().contains("inverted"), "{e}");
 
+    // A hex that lists a corner twice keeps a positive volume: refused, naming cell and node.
+    let mut raw = BoxSpec::uniform([0.0; 3], [1.0; 3], [2, 2, 2], BoxCells::Hex).raw().unwrap();
+    raw.cells[5].nodes[3] = raw.cells[5].nodes[2];
+    let node = raw.cells[5].nodes[2];
+    let e = Mesh::build(raw).unwrap_err();
+    assert!(matches!(e, MeshError::RepeatedNode { cell: 5, node: n, .. } if n == node), "{e}");
+    assert!(e.to_string().contains(&format!("cell 5 (hexahedron) lists node {node} twice")), "{e}");
+
     let mut raw = BoxSpec::uniform([0.0; 3], [1.0; 3], [2, 2, 2], BoxCells::Hex).raw().unwrap();
     raw.faces.pop();
     let e = Mesh::build(raw).unwrap_err();

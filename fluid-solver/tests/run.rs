@@ -171,3 +171,152 @@ fn the_binary_runs_a_case() {
     assert!(r.stderr.is_empty(), "stderr not clean: {}", String::from_utf8_lossy(&r.stderr));
     assert!(out.join("fluid.xdmf").is_file());
 }
+
+/// The times the lines were written at, from their file names `<name>_t<time>.csv`, ascending.
+fn line_times(out: &Path, name: &str) -> Vec<f64> {
+    let prefix = format!("{name}_t");
+    let mut times: Vec<f64> = std::fs::read_dir(out.join("lines"))
+        .unwrap()
+        .filter_map(|e| {
+            let file = e.unwrap().file_name().to_string_lossy().into_owned();
+            let t = file.strip_prefix(&prefix)?.strip_suffix(".csv")?.to_string();
+            Some(t.parse().unwrap_or_else(|_| panic!("{file}")))
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times
+}
+
+/// The mean density error of a line sample against Sod's exact solution at `t`.
+fn sod_error(sample: &Path, t: f64) -> f64 {
+    let exact = ExactTube::new(
+        Eos::PerfectGas { gamma: 1.4 },
+        [1.0, 0.0, 0.0, 0.0, 1.0],
+        [0.125, 0.0, 0.0, 0.0, 0.1],
+        0.3,
+        t,
+    );
+    let text = std::fs::read_to_string(sample).unwrap();
+    let rows: Vec<Vec<f64>> =
+        text.lines().skip(1).map(|r| r.split(',').map(|s| s.parse().unwrap()).collect()).collect();
+    rows.iter().map(|v| (v[4] - exact.at(v[0])[0]).abs()).sum::<f64>() / rows.len() as f64
+}
+
+/// `cases/sod-tube` asks for its line at t = 0.1 and runs to 0.2: the step that would pass 0.1
+/// is shortened, the line is written at exactly t = 0.1 (and so named) and matches the exact
+/// solution at 0.1; the probes have a row at 0.1, and the CFL step resumes after it.
+#[test]
+fn line_samples_land_exactly_on_their_times() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sod");
+    let o = vec![
+        "fluid.mesh.box.cells=[50,1,1]".to_string(),
+        "fluid.lines=[{name=\"axis\",from=[0,0,0],to=[1,0,0],points=51,times=[0.0,0.1]}]".into(),
+    ];
+    let summary = run_case(&out, &o, None).unwrap();
+    assert_eq!(summary.time, 0.2);
+    assert_eq!(line_times(&out, "axis"), [0.0, 0.1]);
+    let at = |t: f64| out.join("lines").join(format!("axis_t{t:.6e}.csv"));
+    let err = sod_error(&at(0.1), 0.1);
+    println!("{} steps; mean |Δρ| at t = 0.1: {err:.5}", summary.steps);
+    assert!(err < 0.02, "mean density error along the line {err}");
+    // The initial sample is the initial state: ρ = 1 left of the diaphragm, 0.125 right of it.
+    let first = std::fs::read_to_string(at(0.0)).unwrap();
+    let rho: Vec<f64> =
+        first.lines().skip(1).map(|r| r.split(',').nth(4).unwrap().parse().unwrap()).collect();
+    assert!(rho[0] == 1.0 && rho[50] == 0.125, "{rho:?}");
+    let probes = std::fs::read_to_string(out.join("probes.csv")).unwrap();
+    let times: Vec<f64> =
+        probes.lines().skip(1).map(|r| r.split(',').next().unwrap().parse().unwrap()).collect();
+    let k = times.iter().position(|&t| t == 0.1).expect("a step ends at t = 0.1");
+    // The steps around it: the shortened one, then a full CFL step again.
+    let dt: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    assert!(dt[k - 1] < dt[k - 2] && dt[k] > dt[k - 1], "{:?}", &dt[k - 2..=k]);
+    assert_eq!(times.len() as u64, summary.steps + 1);
+}
+
+/// A restart between two line times writes the later one as the uninterrupted run does.
+#[test]
+fn a_restart_between_line_times_is_bitwise_identical() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = |extra: &str| {
+        let mut v = vec![
+            "fluid.mesh.box.cells=[50,1,1]".to_string(),
+            "fluid.time.t_end=0.12".to_string(),
+            "fluid.lines=[{name=\"axis\",from=[0,0,0],to=[1,0,0],points=51,times=[0.03,0.1]}]"
+                .to_string(),
+        ];
+        v.extend((!extra.is_empty()).then(|| extra.to_string()));
+        v
+    };
+    let (full, first, second) =
+        (dir.path().join("full"), dir.path().join("first"), dir.path().join("second"));
+    let a = run_case(&full, &o(""), None).unwrap();
+    let b = run_case(&first, &o("fluid.time.max_steps=20"), None).unwrap();
+    assert!(b.time > 0.03 && b.time < 0.1, "stopped at {}", b.time);
+    let c = run_case(&second, &o(""), Some(first.clone())).unwrap();
+    assert_eq!((a.steps, a.time.to_bits()), (c.steps, c.time.to_bits()));
+    assert_eq!(line_times(&first, "axis"), [0.03]);
+    assert_eq!(line_times(&second, "axis"), [0.1], "only what was not written before");
+    let name = format!("lines/axis_t{:.6e}.csv", 0.1);
+    assert_eq!(
+        std::fs::read(full.join(&name)).unwrap(),
+        std::fs::read(second.join(&name)).unwrap()
+    );
+    let (sa, _, _) = read_checkpoint(&full, a.nodes).unwrap();
+    let (sc, _, _) = read_checkpoint(&second, c.nodes).unwrap();
+    assert!(sa
+        .cons
+        .iter()
+        .flatten()
+        .zip(sc.cons.iter().flatten())
+        .all(|(p, q)| p.to_bits() == q.to_bits()));
+}
+
+/// Checkpoints are named by `checkpoint::tag_for_step`: every `checkpoint_every` steps and at
+/// the end.
+#[test]
+fn checkpoint_folders_are_named_by_the_shared_tag() {
+    use interface_protocol::io::checkpoint::tag_for_step;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ck");
+    let s = run_case(&out, &small(&["output.checkpoint_every=10"]), None).unwrap();
+    let mut found: Vec<String> = std::fs::read_dir(out.join("checkpoints"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    found.sort();
+    let mut expected: Vec<String> = (10..=s.steps).step_by(10).map(tag_for_step).collect();
+    if s.steps % 10 != 0 {
+        expected.push(tag_for_step(s.steps));
+    }
+    expected.sort();
+    assert_eq!(found, expected);
+}
+
+/// A folder that holds a run is not overwritten without `--force`.
+#[test]
+fn the_binary_refuses_a_used_output_folder_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cli");
+    let run = |force: bool| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_fluid-solver"));
+        cmd.arg("run").arg(case_path()).arg("--out").arg(&out).arg("--quiet");
+        if force {
+            cmd.arg("--force");
+        }
+        for s in small(&[]) {
+            cmd.arg("--set").arg(s);
+        }
+        cmd.output().unwrap()
+    };
+    assert!(run(false).status.success());
+    let before = std::fs::read(out.join("run.json")).unwrap();
+    let again = run(false);
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    assert!(!again.status.success() && stderr.contains("--force"), "{stderr}");
+    assert_eq!(std::fs::read(out.join("run.json")).unwrap(), before, "left untouched");
+    let forced = run(true);
+    assert!(forced.status.success(), "{}", String::from_utf8_lossy(&forced.stderr));
+    assert_ne!(std::fs::read(out.join("run.json")).unwrap(), before, "a fresh run.json");
+}

@@ -56,6 +56,11 @@ fn node_cells(n: usize, cells: &[Cell]) -> (Vec<usize>, Vec<u32>) {
     (offsets, list)
 }
 
+/// A node a cell lists twice (its corners must be distinct), if any.
+pub(super) fn repeated_node(nodes: &[u32]) -> Option<u32> {
+    nodes.iter().enumerate().find(|&(a, v)| nodes[..a].contains(v)).map(|(_, &v)| v)
+}
+
 pub(super) fn build(mut raw: RawMesh) -> Result<Mesh, MeshError> {
     let n_raw = raw.coords.len();
     for (k, c) in raw.cells.iter().enumerate() {
@@ -65,6 +70,14 @@ pub(super) fn build(mut raw: RawMesh) -> Result<Mesh, MeshError> {
                 cell: k,
                 node,
                 n_nodes: n_raw,
+            });
+        }
+        if let Some(node) = repeated_node(c.nodes()) {
+            return Err(MeshError::RepeatedNode {
+                origin: raw.origin.clone(),
+                cell: k,
+                kind: c.kind.name(),
+                node,
             });
         }
     }

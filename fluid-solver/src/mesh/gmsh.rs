@@ -59,6 +59,13 @@ fn from_msh(msh: Msh) -> Result<RawMesh, GmshError> {
                 for (ids, (&tag, &at)) in
                     block.elements().zip(block.tags.iter().zip(&block.positions))
                 {
+                    if let Some(node) = super::dual::repeated_node(ids) {
+                        return Err(msh.error(at, format!(
+                            "element {tag} ({}) lists node {} twice: its corners must be distinct nodes",
+                            k.name(),
+                            msh.node_tags[node as usize]
+                        )));
+                    }
                     let volume = signed_volume(k, ids, &msh.coords);
                     let size = ids
                         .iter()

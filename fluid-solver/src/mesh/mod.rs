@@ -20,6 +20,7 @@ pub mod cell;
 mod dual;
 pub mod geometry;
 pub mod gmsh;
+pub mod locate;
 pub mod renumber;
 
 pub use blocks::EdgeBlocks;
@@ -81,6 +82,8 @@ pub struct Mesh {
 pub enum MeshError {
     #[error("{origin}: cell {cell} ({kind}) is inverted or has zero volume (volume {volume:e}); its nodes must follow gmsh's ordering with a positive orientation")]
     BadCell { origin: String, cell: usize, kind: &'static str, volume: f64 },
+    #[error("{origin}: cell {cell} ({kind}) lists node {node} twice: its corners must be distinct nodes")]
+    RepeatedNode { origin: String, cell: usize, kind: &'static str, node: u32 },
     #[error("{origin}: cell {cell} refers to node {node}, but the mesh has {n_nodes} nodes")]
     BadNode { origin: String, cell: usize, node: u32, n_nodes: usize },
     #[error("{origin}: boundary face {nodes:?} of `{patch}` is not a face of any volume cell")]
@@ -139,6 +142,19 @@ impl Mesh {
             }
         }
         s
+    }
+
+    /// The corners `(lo, hi)` of the axis-aligned box around the nodes.
+    pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.coords {
+            for d in 0..3 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        (lo, hi)
     }
 
     /// Shortest edge length at each node.

@@ -6,3 +6,12 @@ pub mod rk2;
 
 pub use cfl::TimeStepping;
 pub use rk2::rk2_step;
+
+/// Relative slack within which a time counts as reached.
+const REACHED: f64 = 1e-12;
+
+/// Whether the time `t` has reached `target` (to a relative `1e-12`, so that round-off in a sum
+/// of steps does not leave a step of zero length to take).
+pub fn reached(t: f64, target: f64) -> bool {
+    t >= target - REACHED * target.abs()
+}

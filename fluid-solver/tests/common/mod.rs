@@ -2,6 +2,8 @@
 //! shock-tube solutions, error norms and the committed JSON references.
 #![allow(dead_code)]
 
+pub mod msh;
+
 use fluid_solver::bc::BoundaryCondition;
 use fluid_solver::eos::Eos;
 use fluid_solver::initial::InitialCondition;
