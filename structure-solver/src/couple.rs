@@ -2,10 +2,10 @@
 //! participant of the staggered schemes (coupling-sequence; DESIGN §4, thesis §3.2 after Farhat,
 //! van der Zee and Geuzaine, CMAME 2006).
 //!
-//! The wet surface is the set `structure.wet_set` of shell faces (a cell set of the mesh, or the
-//! shells whose nodes all lie in that node set), or the outward boundary triangles of a cell
-//! set of tets; its nodes are numbered in order of first
-//! appearance in those faces, every face carries `phi = 1`. The fluid's nodal loads are added to
+//! The wet surface is the set `structure.wet_set` ([`crate::wet`]); every face carries
+//! `phi = 1`. Every step the structure checks its state finite before it writes or publishes
+//! anything (`state_check`, as a run alone does) and fails the step naming the node and dof.
+//! The fluid's nodal loads are added to
 //! the external force of the wet nodes' translations. Integrators per scheme: CSS and C0 central
 //! differences (C0: `F^{n+1} = (F^{n+1/2} + F^{n+3/2})/2` in `a^{n+1}`), A6 the implicit
 //! midpoint rule with `F^{n+1/2}` held over the step.
@@ -23,114 +23,20 @@ use interface_protocol::handshake::HelloInfo;
 use interface_protocol::io::checkpoint::Checkpoint;
 use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::ProbeWriter;
-use interface_protocol::messages::{
-    scheme_phase, Command, NodeLoad, NodeState, StepHeader, SurfaceElement,
-};
+use interface_protocol::messages::{scheme_phase, Command, NodeLoad, NodeState, StepHeader};
 use interface_protocol::participant::{failure_code, serve, Failure, Handler, Progress};
 
 use interface_protocol::io::progress::Progress as Bar;
 
 use crate::assembly::{FeModel, RotaryInertia};
-use crate::mesh::{CellKind, Mesh};
+use crate::build::{build, field_error, need, section, Structure};
 use crate::model::Model;
 use crate::output::FieldOutput;
 use crate::restart::{save_dynamics, save_state, PART};
-use crate::run::{build, need, section, Structure};
+use crate::state_check::{check_dofs, check_state};
 use crate::time::{critical_dt, CentralDifference, Implicit, ImplicitScheme};
 
-/// The wet surface sent to the fluid.
-#[derive(Debug, Clone, PartialEq)]
-pub struct WetSurface {
-    /// Structure node of each wet node, in wet-surface order.
-    pub nodes: Vec<usize>,
-    /// Faces indexing `nodes`.
-    pub elements: Vec<SurfaceElement>,
-}
-
-/// The wet surface named `name`: the cell set of that name (shell faces, or tets whose boundary
-/// faces wet, see [`tet_boundary`]), else the triangles and quadrilaterals whose nodes all belong
-/// to the node set of that name.
-pub fn wet_surface(mesh: &Mesh, name: &str) -> Result<WetSurface, String> {
-    let is_face = |k: CellKind| matches!(k, CellKind::Tri3 | CellKind::Quad4);
-    let faces: Vec<Vec<usize>> = if let Ok(cells) = mesh.cell_set(name) {
-        let solid = cells.first().is_some_and(|&c| mesh.cells[c].kind == CellKind::Tet4);
-        let expected = |k: CellKind| if solid { k == CellKind::Tet4 } else { is_face(k) };
-        if let Some(&c) = cells.iter().find(|&&c| !expected(mesh.cells[c].kind)) {
-            let what = if solid {
-                "tetrahedra only (the set's first cell is one)"
-            } else {
-                "shell faces (triangles or quadrilaterals) or tetrahedra"
-            };
-            return Err(format!(
-                "wet set \"{name}\": cell {c} is a {:?}, expected {what}",
-                mesh.cells[c].kind
-            ));
-        }
-        if solid {
-            tet_boundary(mesh, cells).into_iter().map(|f| f.to_vec()).collect()
-        } else {
-            cells.iter().map(|&c| mesh.cells[c].nodes.clone()).collect()
-        }
-    } else {
-        let nodes = mesh.node_set(name).map_err(|e| format!("wet set: {e}"))?;
-        let mut inside = vec![false; mesh.nodes.len()];
-        nodes.iter().for_each(|&n| inside[n] = true);
-        mesh.cells
-            .iter()
-            .filter(|c| is_face(c.kind) && c.nodes.iter().all(|&n| inside[n]))
-            .map(|c| c.nodes.clone())
-            .collect()
-    };
-    if faces.is_empty() {
-        return Err(format!("wet set \"{name}\" holds no shell face or tetrahedron"));
-    }
-    let mut local = vec![u32::MAX; mesh.nodes.len()];
-    let mut nodes = Vec::new();
-    let mut elements = Vec::with_capacity(faces.len());
-    for face in faces {
-        let mut e = SurfaceElement { n_nodes: face.len() as u8, ..Default::default() };
-        for (k, &n) in face.iter().enumerate() {
-            if local[n] == u32::MAX {
-                local[n] = nodes.len() as u32;
-                nodes.push(n);
-            }
-            e.nodes[k] = local[n];
-        }
-        elements.push(e);
-    }
-    Ok(WetSurface { nodes, elements })
-}
-
-/// The boundary of the tets `cells`: the faces that belong to exactly one of them, as triangles
-/// ordered counter-clockwise seen from outside (normal `(x1 - x0) × (x2 - x0)` away from the
-/// tet's fourth node), in cell order.
-fn tet_boundary(mesh: &Mesh, cells: &[usize]) -> Vec<[usize; 3]> {
-    let mut faces = Vec::with_capacity(4 * cells.len());
-    let mut count = std::collections::HashMap::new();
-    for &c in cells {
-        let t = &mesh.cells[c].nodes;
-        for opp in 0..4 {
-            let f: [usize; 3] = std::array::from_fn(|k| t[(opp + 1 + k) % 4]);
-            let mut key = f;
-            key.sort_unstable();
-            *count.entry(key).or_insert(0usize) += 1;
-            faces.push((key, f, t[opp]));
-        }
-    }
-    let p = |n: usize| nalgebra::Vector3::from(mesh.nodes[n]);
-    faces
-        .into_iter()
-        .filter(|(key, _, _)| count[key] == 1)
-        .map(|(_, [a, b, c], opp)| {
-            let normal = (p(b) - p(a)).cross(&(p(c) - p(a)));
-            if normal.dot(&(p(opp) - p(a))) > 0.0 {
-                [a, c, b]
-            } else {
-                [a, b, c]
-            }
-        })
-        .collect()
-}
+pub use crate::wet::{wet_surface, WetSurface};
 
 /// The integrator of the scheme, created at START from the load `F^0`.
 enum Stepper {
@@ -152,8 +58,9 @@ pub struct Participant {
     scheme: Scheme,
     model: FeModel,
     wet: WetSurface,
-    /// Reference positions of all nodes.
+    /// Reference positions of all nodes, and the user's id of each (for messages).
     x0: Vec<[f64; 3]>,
+    node_ids: Vec<u64>,
     v0: Vec<f64>,
     stepper: Option<Stepper>,
     /// Length of the first coupling step (START carries none), and the end of the run (the last
@@ -192,41 +99,72 @@ fn io_failure(what: &str, e: impl std::fmt::Display) -> Failure {
     Failure::new(failure_code::IO, format!("{what}: {e}"))
 }
 
+/// The structure of a coupled case, checked before the run starts (shared with `check`): the
+/// model for the scheme's integrator, its wet surface and the stable step of central
+/// differences (infinite for A6).
+pub struct Coupled {
+    pub structure: Structure,
+    pub wet: WetSurface,
+    pub dt_stable: f64,
+}
+
+/// Builds and checks the `[structure]` of a coupled `case`.
+pub fn prepare_coupled(case: &Case) -> anyhow::Result<Coupled> {
+    let s = section(case)?;
+    let scheme = case.coupling.scheme;
+    let explicit = scheme != Scheme::A6;
+    let expected = if explicit { Integrator::CentralDifference } else { Integrator::Midpoint };
+    if let Some(i) = s.integrator {
+        if i != expected {
+            return Err(field_error(
+                case,
+                "structure.integrator",
+                format!(
+                    "the {scheme:?} scheme integrates the structure with \"{}\", got \"{}\"",
+                    expected.name(),
+                    i.name()
+                ),
+            ));
+        }
+    }
+    let rotary = if explicit { RotaryInertia::Scaled } else { RotaryInertia::Physical };
+    let mut structure = build(case, rotary)?;
+    if !explicit && !structure.model.has_tangent() {
+        let field = if s.parts.is_empty() { "element" } else { "parts" };
+        return Err(field_error(
+            case,
+            &format!("structure.{field}"),
+            "bt4 shells are explicit; the A6 scheme needs mitc4 or dkt shells",
+        ));
+    }
+    let wet_name = need(&s.wet_set, "wet_set", case)?;
+    let wet = wet_surface(&structure.mesh, wet_name)
+        .map_err(|e| field_error(case, "structure.wet_set", e))?;
+    let dt_stable = if explicit {
+        critical_dt(&mut structure.model, 0.0, 100, 1e-9 * structure.length).stable(1.0)
+    } else {
+        f64::INFINITY
+    };
+    Ok(Coupled { structure, wet, dt_stable })
+}
+
+/// The refusal of a first coupling step `dt` above the stable step of the scheme's central
+/// differences.
+pub fn unstable_coupling(dt: f64, dt_stable: f64, scheme: Scheme) -> Option<String> {
+    (dt > dt_stable).then(|| {
+        format!(
+            "coupling.dt = {dt:.3e} exceeds the stable step {dt_stable:.3e} of the {scheme:?} scheme's central differences"
+        )
+    })
+}
+
 impl Participant {
     /// The participant of `case` writing into `out`.
     pub fn new(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Participant> {
-        let file = &case.source.path;
         let s = section(case)?;
         let scheme = case.coupling.scheme;
-        let explicit = scheme != Scheme::A6;
-        let expected = if explicit { Integrator::CentralDifference } else { Integrator::Midpoint };
-        if let Some(i) = s.integrator {
-            if i != expected {
-                bail!(
-                    "{}: field `structure.integrator`: the {scheme:?} scheme integrates the structure with \"{}\", got \"{}\"",
-                    file.display(),
-                    expected.name(),
-                    i.name()
-                );
-            }
-        }
-        let rotary = if explicit { RotaryInertia::Scaled } else { RotaryInertia::Physical };
-        let Structure { mesh, mut model, v0, cells, length } = build(case, rotary)?;
-        if !explicit && !model.has_tangent() {
-            let field = if s.parts.is_empty() { "element" } else { "parts" };
-            bail!(
-                "{}: field `structure.{field}`: bt4 shells are explicit; the A6 scheme needs mitc4 or dkt shells",
-                file.display()
-            );
-        }
-        let wet_name = need(&s.wet_set, "wet_set", file)?;
-        let wet = wet_surface(&mesh, wet_name)
-            .map_err(|e| anyhow!("{}: field `structure.wet_set`: {e}", file.display()))?;
-        let dt_stable = if explicit {
-            critical_dt(&mut model, 0.0, 100, 1e-9 * length).stable(1.0)
-        } else {
-            f64::INFINITY
-        };
+        let Coupled { structure, wet, dt_stable } = prepare_coupled(case)?;
+        let Structure { mesh, model, v0, cells, .. } = structure;
         let dir = OutputDir::create(out, Policy::Existing)
             .or_else(|_| OutputDir::create(out, Policy::Overwrite))?;
         let names: Vec<&str> = s.probes.iter().map(|p| p.name.as_str()).collect();
@@ -241,6 +179,7 @@ impl Participant {
             scheme,
             wet,
             x0: mesh.nodes.clone(),
+            node_ids: (0..mesh.nodes.len()).map(|i| mesh.node_id(i)).collect(),
             v0,
             stepper: None,
             first_dt: case.coupling.dt.min(case.coupling.t_end),
@@ -297,24 +236,24 @@ impl Participant {
     ) -> Result<(), Failure> {
         let header = StepHeader { step, time: t, dt, topology_version: 1, count: 0 };
         let (wet, x0, up, vp) = (&self.wet.nodes, &self.x0, &self.up, &self.vp);
-        let mut bad = None;
+        let ids = &self.node_ids;
+        let id = |i: usize| ids[i];
+        check_dofs("displacement sent", up, &id)
+            .and_then(|()| check_dofs("velocity sent", vp, &id))
+            .map_err(|e| {
+                Failure::new(
+                    failure_code::SOLVER,
+                    format!("step {step}, t = {t:e}: {e}: the structure diverged"),
+                )
+            })?;
         ep.publish_kinematics(header, wet.len(), |out: &mut [NodeState]| {
             for (o, &n) in out.iter_mut().zip(wet) {
                 for k in 0..3 {
                     o.x[k] = x0[n][k] + up[6 * n + k];
                     o.v[k] = vp[6 * n + k];
                 }
-                if bad.is_none() && !(o.x.iter().chain(&o.v).all(|c| c.is_finite())) {
-                    bad = Some(n);
-                }
             }
         })?;
-        if let Some(n) = bad {
-            return Err(Failure::new(
-                failure_code::SOLVER,
-                format!("non-finite kinematics at node {n} for t = {t}: the structure diverged"),
-            ));
-        }
         Ok(())
     }
 
@@ -353,13 +292,9 @@ impl Participant {
                 ),
             ));
         }
-        if let Some(i) = self.load.iter().position(|f| !f.is_finite()) {
-            return Err(Failure::new(
-                failure_code::SOLVER,
-                format!("the fluid sent a non-finite load on structure node {}", i / 6),
-            ));
-        }
-        Ok(())
+        let ids = &self.node_ids;
+        check_dofs("load from the fluid", &self.load, &|i| ids[i])
+            .map_err(|e| Failure::new(failure_code::SOLVER, format!("{e}: the fluid diverged")))
     }
 
     /// START: `a^0` from `F^0`; C0 publishes the prediction for `t^{1/2}`.
@@ -481,6 +416,7 @@ impl Participant {
                 ))
             }
         }
+        self.check_state(n, t_to, dt)?;
         self.t = t_to;
         self.steps = n + 1;
         let (fields, model) = (self.fields.as_mut(), &self.model);
@@ -503,6 +439,26 @@ impl Participant {
             self.write_probes()?;
         }
         Ok(())
+    }
+
+    /// The state after step `n` (to `t_to`), checked finite before anything is written.
+    fn check_state(&mut self, n: u64, t_to: f64, dt: f64) -> Result<(), Failure> {
+        let (v, a, f_int) = match &self.stepper {
+            Some(Stepper::Explicit(cd)) => (&cd.state.v, &cd.state.a, Some(cd.internal_force())),
+            Some(Stepper::Midpoint(im)) => (&im.state.v, &im.state.a, None),
+            None => return Ok(()),
+        };
+        let ids = &self.node_ids;
+        check_state(&self.model, &mut self.disp, (v, a, f_int), &|i| ids[i]).map_err(|e| {
+            let note = match unstable_coupling(dt, self.dt_stable, self.scheme) {
+                Some(m) => format!(" ({m})"),
+                None => String::new(),
+            };
+            Failure::new(
+                failure_code::SOLVER,
+                format!("step {n} to t = {t_to:e}: {e}: the structure diverged{note}"),
+            )
+        })
     }
 
     /// Writes the state last gathered into `structure.xdmf` (once per time).
@@ -563,14 +519,8 @@ impl Participant {
 
 impl Handler<StructureEndpoint> for Participant {
     fn init(&mut self, ep: &mut StructureEndpoint) -> Result<f64, Failure> {
-        if self.first_dt > self.dt_stable {
-            return Err(Failure::new(
-                failure_code::SOLVER,
-                format!(
-                    "coupling.dt = {:.3e} exceeds the stable step {:.3e} of the {:?} scheme's central differences",
-                    self.first_dt, self.dt_stable, self.scheme
-                ),
-            ));
+        if let Some(message) = unstable_coupling(self.first_dt, self.dt_stable, self.scheme) {
+            return Err(Failure::new(failure_code::SOLVER, message));
         }
         let header = StepHeader { step: 0, time: 0.0, dt: 0.0, topology_version: 1, count: 0 };
         let elements = &self.wet.elements;

@@ -1,7 +1,8 @@
-//! `structure-solver`: runs a case alone or as a coupled participant, or benches the kernels.
+//! `structure-solver`: runs a case alone or as a coupled participant, checks a case without
+//! running it, or benches the kernels.
 
 use clap::{Parser, Subcommand};
-use interface_protocol::cli::RunArgs;
+use interface_protocol::cli::{CheckArgs, RunArgs};
 
 #[derive(Parser)]
 #[command(
@@ -23,6 +24,13 @@ enum Command {
         #[arg(long)]
         restart: Option<std::path::PathBuf>,
     },
+    /// Does everything `run` does before the first step (mesh and its checks, sets, parts,
+    /// BCs, loads, probes, the stable step; coupled cases: the wet surface), prints a summary
+    /// and exits; nothing is written.
+    Check {
+        #[command(flatten)]
+        args: CheckArgs,
+    },
     /// Prints the explicit BT4 and implicit Newmark speeds as JSON.
     Bench {
         /// Small sizes (a smoke test, not a measurement).
@@ -31,27 +39,48 @@ enum Command {
     },
 }
 
+/// Warnings of this solver and of the shared crate (a damaged checkpoint skipped) on stderr.
+fn log_warnings() {
+    use tracing_subscriber::filter::{LevelFilter, Targets};
+    use tracing_subscriber::prelude::*;
+    let targets = Targets::new()
+        .with_target("structure_solver", LevelFilter::WARN)
+        .with_target("interface_protocol", LevelFilter::WARN);
+    let layer = tracing_subscriber::fmt::layer()
+        .with_writer(std::io::stderr)
+        .without_time()
+        .with_target(false);
+    tracing_subscriber::registry().with(layer.with_filter(targets)).init();
+}
+
 fn main() {
     let cli = Cli::parse();
+    log_warnings();
     let result = match cli.command {
         Command::Run { args: RunArgs { couple: Some(_), .. }, restart: Some(_) } => {
             Err(anyhow::anyhow!(
                 "--restart applies to runs alone; the launcher drives a coupled run from its start"
             ))
         }
-        Command::Run { args: RunArgs { case, out, set, quiet, couple: Some(run_id) }, .. } => {
-            structure_solver::couple::run(&case, &run_id, out, &set, quiet)
-        }
-        Command::Run { args: RunArgs { case, out, set, quiet, couple: None }, restart } => {
+        Command::Run {
+            args: RunArgs { case, out, set, quiet, couple: Some(run_id), .. }, ..
+        } => structure_solver::couple::run(&case, &run_id, out, &set, quiet),
+        Command::Run { args: RunArgs { case, out, set, quiet, force, couple: None }, restart } => {
             structure_solver::run::run(&structure_solver::run::RunOptions {
                 case,
                 out,
                 set,
                 quiet,
+                force,
                 restart,
             })
             .map(|_| ())
         }
+        Command::Check { args } => args
+            .load_case()
+            .map_err(anyhow::Error::from)
+            .and_then(|case| structure_solver::check::check(&case))
+            .map(|summary| print!("{summary}")),
         Command::Bench { quick } => structure_solver::bench::run(quick).and_then(|r| {
             println!("{}", serde_json::to_string_pretty(&r)?);
             Ok(())

@@ -86,7 +86,9 @@ fn a_bad_dof_name_is_reported_with_file_and_field() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(
-        err.contains("case.toml") && err.contains("structure.loads.dof") && err.contains("`w`"),
+        err.contains("case.toml")
+            && err.contains("case.toml:25:7: field `structure.loads[0].dof`")
+            && err.contains("`w`"),
         "{err}"
     );
 }
@@ -279,7 +281,7 @@ fn semantic_errors_name_the_field_and_what_was_expected() {
             static_,
             "element = \"mitc4\"",
             "element = \"mitc8\"",
-            &["case.toml:19:", "structure.parts.element", "mitc8", "dkt"],
+            &["case.toml:19:", "structure.parts[0].element", "mitc8", "dkt"],
         ),
         // the control node's set must hold one node
         (

@@ -117,14 +117,28 @@ impl Body {
         }
     }
 
-    /// Largest stable central-difference step, 2 / ω_max over the free, unprescribed DOFs
-    /// (`inf` without springs).
-    pub fn dt_stable_explicit(&self) -> f64 {
+    /// The case's name of free DOF `i` (`"x"`, `"rz"`, ...).
+    pub fn dof_name(&self, i: usize) -> &'static str {
+        RIGID_DOFS[self.dofs[i]]
+    }
+
+    /// The highest undamped natural frequency ω_max = max sqrt(k/m) [rad/s] over the free,
+    /// unprescribed DOFs (0 without springs).
+    pub fn omega_max(&self) -> f64 {
         let d = &self.dynamics;
         (0..self.dofs.len())
             .filter(|&i| self.prescribed[i].is_none() && d.k[i] > 0.0)
-            .map(|i| 2.0 / (d.k[i] / d.m[i]).sqrt())
-            .fold(f64::INFINITY, f64::min)
+            .map(|i| (d.k[i] / d.m[i]).sqrt())
+            .fold(0.0, f64::max)
+    }
+
+    /// Largest stable central-difference step, 2 / ω_max over the free, unprescribed DOFs
+    /// (`inf` without springs).
+    pub fn dt_stable_explicit(&self) -> f64 {
+        match self.omega_max() {
+            w if w > 0.0 => 2.0 / w,
+            _ => f64::INFINITY,
+        }
     }
 }
 

@@ -2,14 +2,20 @@
 //! structure state (`coupling::Staggered`) on the body's DOFs, prescribed DOFs imposed, loads
 //! reduced from the wet nodes, kinematics written in place into the shared buffer.
 
+use crate::finite::{check_dofs, check_loads, At};
 use crate::model::Body;
-use crate::probes::Probes;
-use interface_protocol::case::{Case, Scheme};
+use crate::setup::Setup;
+use interface_protocol::case::Scheme;
 use interface_protocol::coupling::Staggered;
 use interface_protocol::endpoint::StructureEndpoint;
+use interface_protocol::io::checkpoint::Checkpoint;
+use interface_protocol::io::outdir::OutputDir;
+use interface_protocol::io::probes::{ProbeError, ProbeWriter};
 use interface_protocol::messages::{scheme_phase, Command, NodeLoad, StepHeader};
 use interface_protocol::participant::{failure_code, Failure, Handler, Progress};
-use std::path::PathBuf;
+
+/// The checkpoint part the rigid structure writes: `checkpoints/<tag>/structure.ckpt`.
+pub const CHECKPOINT_PART: &str = "structure";
 
 /// The rigid structure's state.
 pub struct RigidSolver {
@@ -19,40 +25,41 @@ pub struct RigidSolver {
     load: Vec<f64>,
     /// Time the state `u`, `v`, `a` refers to.
     pub t: f64,
-    probes: Probes,
+    probes: ProbeWriter,
     probes_every: u64,
-    out: PathBuf,
+    out: OutputDir,
+    /// Coupling steps completed.
+    steps: u64,
     /// Length of the first coupling step (Δt, or t_end if that is shorter).
     first_dt: f64,
 }
 
-fn io_failure(what: &str, e: std::io::Error) -> Failure {
+fn io_failure(what: &str, e: impl std::fmt::Display) -> Failure {
     Failure::new(failure_code::IO, format!("{what}: {e}"))
 }
 
+fn probe_failure(e: ProbeError) -> Failure {
+    io_failure("cannot write structure_probes.csv", e)
+}
+
 impl RigidSolver {
-    /// The solver of a case's `[structure.rigid]` writing into `out`.
-    pub fn new(case: &Case, out: PathBuf) -> Result<RigidSolver, String> {
-        let rigid = case.structure.as_ref().and_then(|s| s.rigid.as_ref()).ok_or_else(|| {
-            format!(
-                "{}: rigid-structure needs a [structure.rigid] section",
-                case.source.path.display()
-            )
-        })?;
-        let body = Body::new(rigid);
-        let mut state = Staggered::new(case.coupling.scheme, &body.u0, &body.v0);
+    /// The solver of a case's setup, writing `structure_probes.csv` and checkpoints into `out`.
+    pub fn new(setup: Setup, out: OutputDir) -> Result<RigidSolver, String> {
+        let Setup { body, scheme, dt, t_end, probes_every, .. } = setup;
+        let mut state = Staggered::new(scheme, &body.u0, &body.v0);
         body.impose(0.0, &mut state.u, &mut state.v, Some(&mut state.a));
-        let probes = Probes::create(&out, &body.probe)
-            .map_err(|e| format!("cannot create {}/structure_probes.csv: {e}", out.display()))?;
+        let probes = ProbeWriter::structure(out.path(), &[body.probe.as_str()])
+            .map_err(|e| format!("cannot create the probe file: {e}"))?;
         Ok(RigidSolver {
             load: vec![0.0; body.dofs.len()],
             body,
             state,
             t: 0.0,
             probes,
-            probes_every: case.output.probes_every,
+            probes_every,
             out,
-            first_dt: case.coupling.dt.min(case.coupling.t_end),
+            steps: 0,
+            first_dt: dt.min(t_end),
         })
     }
 
@@ -63,23 +70,46 @@ impl RigidSolver {
 
     /// The stable coupling step of the scheme's structure integrator.
     pub fn dt_stable(&self) -> f64 {
-        match self.state.scheme {
-            Scheme::A6 => f64::INFINITY,
-            Scheme::Css | Scheme::C0 => self.body.dt_stable_explicit(),
-        }
+        crate::setup::dt_stable(self.state.scheme, &self.body)
+    }
+
+    /// Where a check of step `step` of length `dt` at time `t` happens.
+    fn at(&self, t: f64, step: u64, dt: f64) -> At {
+        At { t, step, dt, dt_stable: self.dt_stable() }
+    }
+
+    /// The kinematics to publish are finite.
+    fn check_prediction(&self, at: At) -> Result<(), Failure> {
+        check_dofs(&self.body, "predicted displacement", &self.state.up, at)?;
+        check_dofs(&self.body, "predicted velocity", &self.state.vp, at)
+    }
+
+    /// The state reached is finite.
+    fn check_state(&self, at: At) -> Result<(), Failure> {
+        check_dofs(&self.body, "displacement", &self.state.u, at)?;
+        check_dofs(&self.body, "velocity", &self.state.v, at)?;
+        check_dofs(&self.body, "acceleration", &self.state.a, at)
     }
 
     /// START with the generalized load F^0 in `self.load`; returns whether a prediction is due.
-    fn start(&mut self, dt: f64) -> bool {
+    fn start(&mut self, dt: f64) -> Result<bool, Failure> {
         let publish = self.state.start(&self.body.dynamics, &self.load, dt);
         let s = &mut self.state;
         self.body.impose(0.0, &mut s.u, &mut s.v, Some(&mut s.a));
         self.body.impose(0.5 * dt, &mut s.up, &mut s.vp, None);
-        publish
+        self.check_state(self.at(0.0, 0, dt))?;
+        self.check_prediction(self.at(0.5 * dt, 0, dt))?;
+        Ok(publish)
     }
 
-    /// PREDICT of the step [t_from, t_from + dt]; `load` carries F^{1/2} at C0's first step.
-    fn predict(&mut self, t_from: f64, dt: f64, with_load: bool) -> f64 {
+    /// PREDICT of step `step`, [t_from, t_from + dt]; `load` carries F^{1/2} at C0's first step.
+    fn predict(
+        &mut self,
+        step: u64,
+        t_from: f64,
+        dt: f64,
+        with_load: bool,
+    ) -> Result<f64, Failure> {
         let load = with_load.then_some(self.load.as_slice());
         self.state.predict(dt, load);
         // The time the prediction stands for (CSS: the held state t^n).
@@ -90,23 +120,25 @@ impl RigidSolver {
         };
         let s = &mut self.state;
         self.body.impose(target, &mut s.up, &mut s.vp, None);
-        target
+        self.check_prediction(self.at(target, step, dt))?;
+        Ok(target)
     }
 
-    /// CORRECT with the generalized load in `self.load`; the state reaches `t_to`.
-    fn correct(&mut self, t_to: f64, dt: f64) {
+    /// CORRECT of step `step` with the generalized load in `self.load`; the state reaches `t_to`.
+    fn correct(&mut self, step: u64, t_to: f64, dt: f64) -> Result<(), Failure> {
         self.state.correct(&self.body.dynamics, &self.load, dt);
         let s = &mut self.state;
         self.body.impose(t_to, &mut s.u, &mut s.v, Some(&mut s.a));
+        self.check_state(self.at(t_to, step, dt))?;
         self.t = t_to;
+        self.steps = step + 1;
+        Ok(())
     }
 
     /// Writes the probe row of the current state.
     fn write_probe(&mut self) -> Result<(), Failure> {
         let (u, v) = (self.body.full(&self.state.u), self.body.full(&self.state.v));
-        self.probes
-            .row(self.t, [u[0], u[1], u[2]], [v[0], v[1], v[2]])
-            .map_err(|e| io_failure("cannot write structure_probes.csv", e))
+        self.probes.write_row(self.t, &[u[0], u[1], u[2], v[0], v[1], v[2]]).map_err(probe_failure)
     }
 
     /// Integrates alone from 0 to `t_end` with zero fluid load, the scheme's structure integrator
@@ -114,18 +146,19 @@ impl RigidSolver {
     pub fn run_alone(&mut self, dt: f64, n_steps: u64, t_end: f64) -> Result<(), Failure> {
         self.write_probe()?;
         self.load.fill(0.0);
-        self.start(dt);
+        self.start(dt)?;
         for step in 0..n_steps {
             let t_from = step as f64 * dt;
             let t_to = if step + 1 == n_steps { t_end } else { t_from + dt };
             self.load.fill(0.0);
-            self.predict(t_from, t_to - t_from, self.state.predict_reads_load(step));
-            self.correct(t_to, t_to - t_from);
+            let with_load = self.state.predict_reads_load(step);
+            self.predict(step, t_from, t_to - t_from, with_load)?;
+            self.correct(step, t_to, t_to - t_from)?;
             if (step + 1) % self.probes_every == 0 || step + 1 == n_steps {
                 self.write_probe()?;
             }
         }
-        self.probes.flush().map_err(|e| io_failure("cannot write structure_probes.csv", e))
+        self.probes.flush().map_err(probe_failure)
     }
 
     /// Publishes the kinematics (`up`, `vp` when `predicted`, else `u`, `v`) for time `t`.
@@ -147,15 +180,17 @@ impl RigidSolver {
         Ok(())
     }
 
-    /// Reads the fluid's loads into `self.load` (generalized, at the current state).
-    fn read_loads(&mut self, ep: &mut StructureEndpoint) -> Result<(), Failure> {
+    /// Reads the fluid's loads into `self.load` (generalized, at the current state); `at` names
+    /// the step in the error of a non-finite load.
+    fn read_loads(&mut self, ep: &mut StructureEndpoint, at: At) -> Result<(), Failure> {
         let n = self.n_nodes();
         let (body, u, load) = (&self.body, &self.state.u, &mut self.load);
-        let count = ep.read_loads(|_, loads: &[NodeLoad]| {
-            if loads.len() == n {
+        let (count, finite) = ep.read_loads(|_, loads: &[NodeLoad]| {
+            let finite = check_loads(loads, at);
+            if loads.len() == n && finite.is_ok() {
                 body.reduce(u, loads, load);
             }
-            loads.len()
+            (loads.len(), finite)
         })?;
         if count != n {
             return Err(Failure::new(
@@ -163,7 +198,7 @@ impl RigidSolver {
                 format!("the fluid sent {count} nodal loads, the structure has {n} wet nodes"),
             ));
         }
-        Ok(())
+        finite
     }
 }
 
@@ -182,22 +217,23 @@ impl Handler<StructureEndpoint> for RigidSolver {
         match c.scheme_phase {
             scheme_phase::START => {
                 // START carries t_from = t_to = 0: the first step's Δt comes from the case.
-                self.read_loads(ep)?;
-                if self.start(self.first_dt) {
-                    self.publish(ep, 0, 0.5 * self.first_dt, self.first_dt, true)?;
+                let first = self.first_dt;
+                self.read_loads(ep, self.at(0.0, c.step, first))?;
+                if self.start(first)? {
+                    self.publish(ep, 0, 0.5 * first, first, true)?;
                 }
             }
             scheme_phase::PREDICT => {
                 let with_load = self.state.predict_reads_load(c.step);
                 if with_load {
-                    self.read_loads(ep)?;
+                    self.read_loads(ep, self.at(c.t_from, c.step, dt))?;
                 }
-                let target = self.predict(c.t_from, dt, with_load);
+                let target = self.predict(c.step, c.t_from, dt, with_load)?;
                 self.publish(ep, c.step, target, dt, true)?;
             }
             scheme_phase::CORRECT => {
-                self.read_loads(ep)?;
-                self.correct(c.t_to, dt);
+                self.read_loads(ep, self.at(c.t_to, c.step, dt))?;
+                self.correct(c.step, c.t_to, dt)?;
                 if (c.step + 1) % self.probes_every == 0 {
                     self.write_probe()?;
                 }
@@ -215,33 +251,45 @@ impl Handler<StructureEndpoint> for RigidSolver {
     }
 
     fn checkpoint(&mut self, _ep: &mut StructureEndpoint, tag: &str) -> Result<(), Failure> {
-        let dir = self.out.join("checkpoints").join(tag);
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| io_failure("cannot create the checkpoint folder", e))?;
-        let mut text = format!("# rigid-structure state at t = {:.17e}\ndof,u,v,a\n", self.t);
-        for (i, &d) in self.body.dofs.iter().enumerate() {
-            let s = &self.state;
-            text += &format!(
-                "{},{:.17e},{:.17e},{:.17e}\n",
-                interface_protocol::case::RIGID_DOFS[d],
-                s.u[i],
-                s.v[i],
-                s.a[i]
-            );
-        }
-        self.probes.flush().map_err(|e| io_failure("cannot write structure_probes.csv", e))?;
-        std::fs::write(dir.join("rigid-structure.csv"), text)
-            .map_err(|e| io_failure("cannot write the checkpoint", e))
+        self.write_checkpoint(tag)
     }
 
     fn finish(&mut self, _ep: &mut StructureEndpoint) -> Result<(), Failure> {
-        self.probes.flush().map_err(|e| io_failure("cannot write structure_probes.csv", e))
+        self.probes.flush().map_err(probe_failure)
     }
+}
+
+impl RigidSolver {
+    /// Writes `checkpoints/<tag>/structure.ckpt`: `u`, `v`, `a` of the free DOFs, their names in
+    /// the metadata; flushes the probes first.
+    fn write_checkpoint(&mut self, tag: &str) -> Result<(), Failure> {
+        let fail = |e| io_failure("cannot write the checkpoint", e);
+        let mut ck = Checkpoint::new(self.steps, self.t);
+        let names: Vec<&str> = (0..self.body.dofs.len()).map(|i| self.body.dof_name(i)).collect();
+        ck.set_meta(&names).map_err(fail)?;
+        for (name, values) in [("u", &self.state.u), ("v", &self.state.v), ("a", &self.state.a)] {
+            ck.put(name, values.clone()).map_err(fail)?;
+        }
+        self.probes.flush().map_err(probe_failure)?;
+        let dir =
+            self.out.checkpoints().map_err(|e| io_failure("cannot create checkpoints/", e))?;
+        ck.write(&dir, tag, CHECKPOINT_PART).map_err(fail)?;
+        Ok(())
+    }
+}
+
+/// The solver of `case` writing into the existing folder `dir` (tests).
+#[cfg(test)]
+fn solver_in(case: &interface_protocol::case::Case, dir: &std::path::Path) -> RigidSolver {
+    use interface_protocol::io::outdir::Policy;
+    let out = OutputDir::create(dir, Policy::Existing).unwrap();
+    RigidSolver::new(Setup::new(case).unwrap(), out).unwrap()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use interface_protocol::case::Case;
     use std::path::Path;
 
     /// m u'' + c u' + k u = 0, u(0) = u0, u'(0) = 0: the closed form.
@@ -262,7 +310,7 @@ mod tests {
     fn final_error(scheme: &str, dt: f64) -> f64 {
         let dir = tempfile::tempdir().unwrap();
         let c = case(scheme, dt, "");
-        let mut s = RigidSolver::new(&c, dir.path().to_path_buf()).unwrap();
+        let mut s = solver_in(&c, dir.path());
         s.run_alone(dt, c.coupling.n_steps(), 1.0).unwrap();
         assert_eq!(s.t, 1.0);
         (s.state.u[0] - damped(2.0, 50.0, 0.8, 0.01, 1.0)).abs()
@@ -284,7 +332,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let extra = "probe = \"piston\"\n[[structure.rigid.prescribed]]\ndof = \"x\"\namplitude = 0.002\nfrequency = 3.0\n";
         let c = case("C0", 1e-2, extra);
-        let mut s = RigidSolver::new(&c, dir.path().to_path_buf()).unwrap();
+        let mut s = solver_in(&c, dir.path());
         s.run_alone(1e-2, c.coupling.n_steps(), 1.0).unwrap();
         let w = 2.0 * std::f64::consts::PI * 3.0;
         assert!((s.state.u[0] - 0.002 * (1.0 - (w * 1.0).cos())).abs() < 1e-15);
@@ -299,11 +347,74 @@ mod tests {
 }
 
 #[cfg(test)]
+mod failure_tests {
+    //! A diverging state fails the step at once, before any probe row or checkpoint holds it.
+    use super::*;
+    use interface_protocol::case::Case;
+    use interface_protocol::io::checkpoint;
+    use std::path::Path;
+
+    fn case(scheme: &str, dt: f64) -> Case {
+        // ω = 100 rad/s: central differences are stable up to dt = 2e-2 s.
+        let text = format!(
+            "[coupling]\nscheme = \"{scheme}\"\ndt = {dt:e}\nt_end = 20.0\n[structure.rigid]\n\
+             mass = 10.0\nstiffness = 1e5\nu0 = 0.01\nprobe = \"piston\"\n"
+        );
+        Case::parse(&text, Path::new("case.toml"), &[]).unwrap()
+    }
+
+    #[test]
+    fn an_unstable_step_fails_naming_the_dof_the_step_and_the_stable_step() {
+        let dir = tempfile::tempdir().unwrap();
+        let c = case("C0", 0.03);
+        let mut s = solver_in(&c, dir.path());
+        let f = s.run_alone(0.03, c.coupling.n_steps(), 20.0).unwrap_err();
+        assert_eq!(f.code, failure_code::SOLVER);
+        let m = &f.message;
+        assert!(m.contains("of DOF \"x\" is") && m.contains("coupling step"), "{m}");
+        assert!(m.contains("above the stable step 2e-2 s"), "{m}");
+        // It stopped long before t_end, and no probe row holds a NaN or an infinity.
+        assert!(s.t < 20.0, "t = {}", s.t);
+        drop(s);
+        let csv = std::fs::read_to_string(dir.path().join("structure_probes.csv")).unwrap();
+        let rows: Vec<Vec<f64>> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        assert!(rows.len() > 10, "{} rows", rows.len());
+        assert!(rows.iter().flatten().all(|x| x.is_finite()), "a non-finite probe row");
+        // The stable step converges, and A6 is unconditionally stable.
+        let mut s = solver_in(&case("C0", 0.019), tempfile::tempdir().unwrap().path());
+        s.run_alone(0.019, 50, 0.95).unwrap();
+        let mut s = solver_in(&case("A6", 0.03), tempfile::tempdir().unwrap().path());
+        s.run_alone(0.03, 100, 3.0).unwrap();
+    }
+
+    #[test]
+    fn checkpoints_are_checksummed_parts_named_as_everywhere() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut s = solver_in(&case("A6", 0.01), dir.path());
+        s.run_alone(0.01, 5, 0.05).unwrap();
+        s.write_checkpoint(&checkpoint::tag_for_step(5)).unwrap();
+        let found = checkpoint::latest(&dir.path().join("checkpoints"), &[CHECKPOINT_PART])
+            .unwrap()
+            .unwrap();
+        assert_eq!((found.tag.as_str(), found.step, found.time), ("step_0000000005", 5, 0.05));
+        let ck = Checkpoint::read_file(&found.dir.join("structure.ckpt")).unwrap();
+        assert_eq!(ck.meta::<Vec<String>>().unwrap(), ["x"]);
+        assert_eq!(ck.f64("u").unwrap(), s.state.u.as_slice());
+        assert_eq!(ck.f64("v").unwrap(), s.state.v.as_slice());
+    }
+}
+
+#[cfg(test)]
 mod coupled_tests {
     //! The rigid solver through the real transport: a launcher thread drives the coupling
     //! sequence, an analytic piston face answers in a fluid thread, and the piston's motion is
     //! compared with the closed form of m u'' + ρ0 c0 A u' + k u = -A p0.
     use super::*;
+    use interface_protocol::case::Case;
     use interface_protocol::endpoint::{ControlPort, FluidEndpoint, LauncherLink, Timeouts};
     use interface_protocol::handshake::HelloInfo;
     use interface_protocol::messages::{command_kind, reply_kind, Reply, Role};
@@ -360,7 +471,7 @@ mod coupled_tests {
         let structure = {
             let (run_id, case, out) = (run_id.clone(), case.clone(), dir.path().to_path_buf());
             std::thread::spawn(move || {
-                let mut solver = RigidSolver::new(&case, out).unwrap();
+                let mut solver = solver_in(&case, &out);
                 let info = HelloInfo { n_surface_nodes: 1, n_surface_elements: 0, case_hash: 0 };
                 let mut ep = StructureEndpoint::open(&run_id, info, Timeouts::default()).unwrap();
                 serve(&mut ep, &mut solver).unwrap();

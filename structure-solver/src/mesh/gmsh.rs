@@ -3,23 +3,25 @@
 //! (solids) are the cells; points are skipped; any other element type is refused at its block.
 //! Each physical group, of any dimension, becomes a node set (the nodes of its elements) and a
 //! cell set (its cells) of the same name: the name `$PhysicalNames` gives it, or `physical_<tag>`
-//! without one. Errors name the file and the line (the byte offset in binary data).
+//! without one. Errors name the file and the line (the byte offset in binary data); a cell
+//! the validity pass ([`super::validate`]) refuses is named by its element tag and line.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use interface_protocol::io::gmsh::{self, ElementType, GmshError, Msh};
 
+use super::validate::{self, Invalid};
 use super::{Cell, CellKind, Mesh, MeshError};
 
 /// Reads a gmsh 4.1 file.
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
-    gmsh::read(path, accept).map(from_msh).map_err(read_error)
+    gmsh::read(path, accept).and_then(from_msh).map_err(read_error)
 }
 
 /// Parses the bytes of a gmsh 4.1 file named `file` (for messages).
 pub fn parse(bytes: &[u8], file: &str) -> Result<Mesh, MeshError> {
-    gmsh::parse(bytes, file, accept).map(from_msh).map_err(read_error)
+    gmsh::parse(bytes, file, accept).and_then(from_msh).map_err(read_error)
 }
 
 fn read_error(e: GmshError) -> MeshError {
@@ -49,12 +51,14 @@ fn accept(t: ElementType) -> Result<(), String> {
 }
 
 /// Nodes, cells and the sets of the physical groups of `msh` (every block's type is one
-/// [`accept`] let through).
-fn from_msh(msh: Msh) -> Mesh {
+/// [`accept`] let through), checked by [`validate::check`].
+fn from_msh(msh: Msh) -> Result<Mesh, GmshError> {
     let mut cells = Vec::new();
+    // (block, element in block) of each cell, to name it by tag and line.
+    let mut origin = Vec::new();
     let mut cell_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-    for block in &msh.blocks {
+    for (b, block) in msh.blocks.iter().enumerate() {
         let kind = cell_kind(block.kind).ok().flatten();
         let names: Vec<String> = msh
             .physical_groups(block.dim, block.entity)
@@ -70,6 +74,7 @@ fn from_msh(msh: Msh) -> Mesh {
         }
         let Some(kind) = kind else { continue };
         let first = cells.len();
+        origin.extend((0..block.len()).map(|e| (b, e)));
         cells.extend(
             block
                 .elements()
@@ -83,5 +88,18 @@ fn from_msh(msh: Msh) -> Mesh {
         v.sort_unstable();
         v.dedup();
     }
-    Mesh { nodes: msh.coords, cells, node_sets, cell_sets }
+    let Msh { coords: nodes, node_tags: node_ids, .. } = &msh;
+    let mesh =
+        Mesh { nodes: nodes.clone(), cells, node_sets, cell_sets, node_ids: node_ids.clone() };
+    match validate::check(&mesh) {
+        Ok(()) => Ok(mesh),
+        Err(e @ Invalid::Cell { cell, .. }) => {
+            let (b, k) = origin[cell];
+            let block = &msh.blocks[b];
+            Err(msh.error(block.positions[k], e.describe(&format!("element {}", block.tags[k]))))
+        }
+        Err(e @ Invalid::Node { node }) => {
+            Err(msh.error(msh.end, e.describe(&format!("node {}", mesh.node_id(node)))))
+        }
+    }
 }

@@ -1,11 +1,14 @@
 //! Structural meshes: nodes, cells of the element families, and named node and cell sets
 //! (supports, load points, the wet surface). Generators for the benchmark geometries
-//! (`generate`) and a gmsh reader (`gmsh`).
+//! (`generate`), a gmsh reader (`gmsh`), the merge of generated seams (`merge`) and the
+//! validity pass every mesh goes through (`validate`).
 
 use std::collections::BTreeMap;
 
 pub mod generate;
 pub mod gmsh;
+pub mod merge;
+pub mod validate;
 
 /// Cell shapes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,9 +43,26 @@ pub struct Mesh {
     pub cells: Vec<Cell>,
     pub node_sets: BTreeMap<String, Vec<usize>>,
     pub cell_sets: BTreeMap<String, Vec<usize>>,
+    /// The user's id of each node (a gmsh node tag); empty: the index is the id.
+    pub node_ids: Vec<u64>,
 }
 
 impl Mesh {
+    /// The user's id of node `i`, for messages: its gmsh tag, else `i`.
+    pub fn node_id(&self, i: usize) -> u64 {
+        self.node_ids.get(i).copied().unwrap_or(i as u64)
+    }
+
+    /// Adds a node at `p` (with the next free user id when nodes have ids); returns its index.
+    pub fn push_node(&mut self, p: [f64; 3]) -> usize {
+        if !self.node_ids.is_empty() {
+            let next = self.node_ids.iter().max().map_or(0, |m| m + 1);
+            self.node_ids.push(next);
+        }
+        self.nodes.push(p);
+        self.nodes.len() - 1
+    }
+
     /// The nodes of set `name`, or an error naming the set and the ones that exist.
     pub fn node_set(&self, name: &str) -> Result<&[usize], MeshError> {
         self.node_sets.get(name).map(|v| v.as_slice()).ok_or_else(|| MeshError::UnknownSet {
@@ -92,7 +112,13 @@ impl Mesh {
             .iter()
             .map(|(k, v)| (k.clone(), v.iter().flat_map(|&c| map[c].clone()).collect()))
             .collect();
-        Mesh { nodes: self.nodes.clone(), cells, node_sets: self.node_sets.clone(), cell_sets }
+        Mesh {
+            nodes: self.nodes.clone(),
+            cells,
+            node_sets: self.node_sets.clone(),
+            cell_sets,
+            node_ids: self.node_ids.clone(),
+        }
     }
 }
 

@@ -1,0 +1,446 @@
+//! The structure of a case, ready to integrate: the `[structure]` section (DESIGN §7; the
+//! schema is documented in `interface_protocol::case::structure`) made into one
+//! `assembly::FeModel`: the mesh and its sets ([`crate::case_mesh`]), the element part of each
+//! cell, boundary conditions, loads with time curves, rigid bodies and the initial velocity.
+//! Errors name the case file and the field.
+
+use anyhow::anyhow;
+use interface_protocol::case::{
+    BeamSectionSpec, Case, CurveName, CurveSpec, ElementType, Integrator, LoadKind,
+    StructureMaterial, StructureSection, Symmetry,
+};
+
+use crate::assembly::{AssemblyError, Curve, FeModel, Part, RotaryInertia};
+use crate::case_mesh::build_mesh;
+use crate::elements::{BeamSection, ShellSection, ShellYield};
+use crate::material::{Elastic, Material, J2};
+use crate::mesh::{validate, CellKind, Mesh};
+use crate::model::Model;
+use crate::output::CellMap;
+use crate::rigid::{ExtraMass, RigidReference};
+
+pub(crate) fn need<'a, T>(v: &'a Option<T>, field: &str, case: &Case) -> anyhow::Result<&'a T> {
+    v.as_ref().ok_or_else(|| {
+        field_error(case, &format!("structure.{field}"), "is required to run structure-solver")
+    })
+}
+
+/// An error naming the case file, the line of `field` and the field.
+pub(crate) fn field_error(
+    case: &Case,
+    field: &str,
+    message: impl std::fmt::Display,
+) -> anyhow::Error {
+    case.field_error(field, message.to_string()).into()
+}
+
+/// The names of the mesh's sets, for error messages.
+fn known_sets(mesh: &Mesh) -> String {
+    let mut names: Vec<&str> =
+        mesh.node_sets.keys().chain(mesh.cell_sets.keys()).map(String::as_str).collect();
+    names.sort_unstable();
+    names.dedup();
+    names.join(", ")
+}
+
+/// The nodes of set `name` (a node set, else the nodes of a cell set).
+pub(crate) fn node_set(
+    mesh: &Mesh,
+    name: &str,
+    field: &str,
+    case: &Case,
+) -> anyhow::Result<Vec<usize>> {
+    if let Ok(n) = mesh.node_set(name) {
+        return Ok(n.to_vec());
+    }
+    if let Ok(c) = mesh.cell_set(name) {
+        let mut seen = vec![false; mesh.nodes.len()];
+        let mut out = Vec::new();
+        for &ci in c {
+            for &n in &mesh.cells[ci].nodes {
+                if !seen[n] {
+                    seen[n] = true;
+                    out.push(n);
+                }
+            }
+        }
+        return Ok(out);
+    }
+    Err(field_error(case, field, format!("no set \"{name}\"; known sets: {}", known_sets(mesh))))
+}
+
+/// The cells of set `name` (a cell set, else the cells whose nodes all lie in the node set).
+fn cell_set(mesh: &Mesh, name: &str, field: &str, case: &Case) -> anyhow::Result<Vec<usize>> {
+    if let Ok(c) = mesh.cell_set(name) {
+        return Ok(c.to_vec());
+    }
+    if let Ok(nodes) = mesh.node_set(name) {
+        let mut inside = vec![false; mesh.nodes.len()];
+        nodes.iter().for_each(|&n| inside[n] = true);
+        let cells: Vec<usize> = (0..mesh.cells.len())
+            .filter(|&c| mesh.cells[c].nodes.iter().all(|&n| inside[n]))
+            .collect();
+        if cells.is_empty() {
+            return Err(field_error(case, field, format!("node set \"{name}\" holds no cell")));
+        }
+        return Ok(cells);
+    }
+    Err(field_error(case, field, format!("no set \"{name}\"; known sets: {}", known_sets(mesh))))
+}
+
+/// A case curve as the model's.
+fn curve(c: Option<&CurveSpec>, default: Curve) -> Curve {
+    match c {
+        None => default,
+        Some(CurveSpec::Named(CurveName::Constant)) => Curve::Constant,
+        Some(CurveSpec::Named(CurveName::Linear)) => Curve::Linear,
+        Some(CurveSpec::Ramp(r)) => Curve::Table(vec![(0.0, 0.0), (r.ramp, 1.0)]),
+        Some(CurveSpec::Table(t)) => Curve::Table(t.table.iter().map(|p| (p[0], p[1])).collect()),
+    }
+}
+
+/// The shell section and yield of a material.
+fn shell(
+    m: &StructureMaterial,
+    h: f64,
+    points: Option<usize>,
+) -> (ShellSection, Option<ShellYield>) {
+    let section = ShellSection { e: m.e, nu: m.nu, rho: m.rho, h };
+    let yield_ = m.sigma_y.map(|sigma_y| ShellYield {
+        sigma_y,
+        hardening: m.hardening,
+        points: points.unwrap_or(5),
+    });
+    (section, yield_)
+}
+
+fn beam_section(m: &StructureMaterial, s: &BeamSectionSpec) -> BeamSection {
+    match s.rectangle {
+        Some([b, h]) => BeamSection::rectangle(m.e, m.nu, m.rho, b, h),
+        None => BeamSection {
+            e: m.e,
+            nu: m.nu,
+            rho: m.rho,
+            area: s.area.unwrap_or_default(),
+            iy: s.iy.unwrap_or_default(),
+            iz: s.iz.unwrap_or_default(),
+            j: s.j.unwrap_or_default(),
+        },
+    }
+}
+
+/// Dimension of a cell kind.
+fn dimension(k: CellKind) -> usize {
+    match k {
+        CellKind::Line2 => 1,
+        CellKind::Tri3 | CellKind::Quad4 => 2,
+        CellKind::Tet4 => 3,
+    }
+}
+
+/// The element part of every cell, from `[[structure.parts]]` or the single top-level part. A
+/// part without a set takes every cell of the mesh's highest dimension; cells of a lower
+/// dimension in no part (the boundary lines and faces of a gmsh file) only define sets.
+fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<Vec<Option<Part>>> {
+    let materials = s.all_materials();
+    let single;
+    let parts = if s.parts.is_empty() {
+        let element = s.element.unwrap_or(ElementType::Bt4);
+        let thickness = match element {
+            ElementType::Beam => {
+                return Err(field_error(
+                    case,
+                    "structure.element",
+                    "beams need a section and an `up` vector: give them in [[structure.parts]]",
+                ))
+            }
+            ElementType::Tet4 => None,
+            _ => Some(*need(&s.thickness, "thickness", case)?),
+        };
+        single = [interface_protocol::case::StructurePart {
+            set: None,
+            element,
+            material: None,
+            thickness,
+            points: None,
+            section: None,
+            up: None,
+        }];
+        if materials.len() != 1 {
+            need(&s.material, "material", case)?;
+        }
+        &single[..]
+    } else {
+        &s.parts[..]
+    };
+    let top = s.parts.is_empty();
+    let top_dim = mesh.cells.iter().map(|c| dimension(c.kind)).max().unwrap_or(0);
+    let mut out: Vec<Option<(usize, Part)>> = vec![None; mesh.cells.len()];
+    for (k, p) in parts.iter().enumerate() {
+        let f = |key: &str| {
+            if top {
+                format!("structure.{key}")
+            } else {
+                format!("structure.parts[{k}].{key}")
+            }
+        };
+        let m = match &p.material {
+            Some(name) => &materials[name],
+            None => materials.values().next().ok_or_else(|| {
+                field_error(case, "structure.material", "is required to run structure-solver")
+            })?,
+        };
+        let cells = match &p.set {
+            Some(name) => cell_set(mesh, name, &f("set"), case)?,
+            None => (0..mesh.cells.len())
+                .filter(|&c| dimension(mesh.cells[c].kind) == top_dim)
+                .collect(),
+        };
+        let h = p.thickness.unwrap_or_default();
+        let (section, yield_) = shell(m, h, p.points);
+        for c in cells {
+            let kind = mesh.cells[c].kind;
+            let part = match (p.element, kind) {
+                (ElementType::Bt4, CellKind::Quad4) => Part::Bt4(section, yield_),
+                (ElementType::Mitc4, CellKind::Quad4)
+                | (ElementType::Dkt, CellKind::Tri3)
+                | (ElementType::Shell, CellKind::Quad4 | CellKind::Tri3) => match yield_ {
+                    Some(y) => Part::ShellJ2(section, y),
+                    None => Part::Shell(section),
+                },
+                (ElementType::Beam, CellKind::Line2) => {
+                    if m.sigma_y.is_some() {
+                        return Err(field_error(
+                            case,
+                            &f("material"),
+                            "beams are elastic; give a material without sigma_y",
+                        ));
+                    }
+                    let sec = p.section.as_ref().expect("validated: beams have a section");
+                    Part::Beam(beam_section(m, sec), p.up.expect("validated: beams have up"))
+                }
+                (ElementType::Tet4, CellKind::Tet4) => {
+                    let elastic = Elastic { e: m.e, nu: m.nu, rho: m.rho };
+                    Part::Solid(match m.sigma_y {
+                        Some(sigma_y) => Material::J2(J2 { elastic, sigma_y, h: m.hardening }),
+                        None => Material::Elastic(elastic),
+                    })
+                }
+                (e, kind) => {
+                    let needs = match e {
+                        ElementType::Bt4 | ElementType::Mitc4 => "quadrilaterals",
+                        ElementType::Dkt => "triangles",
+                        ElementType::Shell => "triangles or quadrilaterals",
+                        ElementType::Beam => "2-node lines",
+                        ElementType::Tet4 => "tetrahedra",
+                    };
+                    let set = p.set.as_deref().unwrap_or("all");
+                    return Err(field_error(
+                        case,
+                        &f("element"),
+                        format!("{e:?} needs {needs}; cell {c} of set \"{set}\" is a {kind:?}")
+                            .to_lowercase(),
+                    ));
+                }
+            };
+            if let Some((other, _)) = out[c] {
+                return Err(field_error(
+                    case,
+                    &f("set"),
+                    format!("cell {c} already belongs to structure.parts[{other}]"),
+                ));
+            }
+            out[c] = Some((k, part));
+        }
+    }
+    if let Some(c) =
+        (0..out.len()).find(|&c| out[c].is_none() && dimension(mesh.cells[c].kind) == top_dim)
+    {
+        return Err(field_error(
+            case,
+            "structure.parts",
+            format!("cell {c} (a {:?}) belongs to no part; add a part over it", mesh.cells[c].kind),
+        ));
+    }
+    Ok(out.into_iter().map(|p| p.map(|(_, part)| part)).collect())
+}
+
+/// The structure of a case, ready to integrate.
+pub struct Structure {
+    pub mesh: Mesh,
+    pub model: FeModel,
+    /// Initial velocity per dof (zero on constrained dofs).
+    pub v0: Vec<f64>,
+    /// Which mesh cells are the model's elements and BT4 shells (output fields).
+    pub cells: CellMap,
+    /// A length below the element size: the probe of the critical-step power iteration.
+    pub length: f64,
+}
+
+/// Builds the `[structure]` of `case`: mesh and sets, parts, BCs, loads, initial velocity.
+/// `rotary` is the rotary inertia of the shells (`Scaled` for explicit steps).
+pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
+    let s = section(case)?;
+    let mesh = build_mesh(s, case)?;
+    let parts = cell_parts(s, &mesh, case)?;
+    // The model's cells: those of a part, in mesh order.
+    let kept: Vec<usize> = (0..mesh.cells.len()).filter(|&c| parts[c].is_some()).collect();
+    let mut model_cell = vec![None; mesh.cells.len()];
+    kept.iter().enumerate().for_each(|(i, &c)| model_cell[c] = Some(i));
+    let elements = Mesh {
+        nodes: mesh.nodes.clone(),
+        cells: kept.iter().map(|&c| mesh.cells[c].clone()).collect(),
+        ..Mesh::default()
+    };
+    let part = |i: usize| parts[kept[i]].expect("kept cells have a part");
+    let mut fe = FeModel::new(&elements, part).map_err(|e| match e {
+        AssemblyError::Bt4Material { .. } => field_error(
+            case,
+            "structure.parts",
+            "all bt4 parts share one material and number of thickness points",
+        ),
+        e => field_error(case, "structure.parts", e),
+    })?;
+    fe.set_rotary_inertia(rotary);
+    let mut mesh = mesh;
+    // Rigid body of each slave node.
+    let mut body_of = vec![None; mesh.nodes.len()];
+    for (k, rb) in s.rigid_bodies.iter().enumerate() {
+        let f = format!("structure.rigid_bodies[{k}]");
+        let nodes = node_set(&mesh, &rb.set, &format!("{f}.set"), case)?;
+        let reference = match rb.reference {
+            Some(p) => RigidReference::Point(p),
+            None => RigidReference::MassCentre,
+        };
+        let extra = ExtraMass { mass: rb.mass, ..ExtraMass::default() };
+        let master =
+            fe.rigid_body(&nodes, reference, extra).map_err(|e| field_error(case, &f, e))?;
+        // The reference node joins the mesh (output, probes) and the sets `all` and
+        // `<set>_reference`.
+        let p = fe.initial_positions()[master];
+        mesh.push_node([p.x, p.y, p.z]);
+        mesh.node_sets.insert(format!("{}_reference", rb.set), vec![master]);
+        mesh.node_sets.get_mut("all").expect("built with the mesh").push(master);
+        body_of.push(None);
+        nodes.iter().for_each(|&n| body_of[n] = Some(k));
+    }
+    let statics = s.integrator() == Integrator::Static;
+    let default_curve = if statics { Curve::Linear } else { Curve::Constant };
+    let mut skew = Vec::new();
+    for (k, bc) in s.bc.iter().enumerate() {
+        let f = format!("structure.bc[{k}]");
+        let nodes = node_set(&mesh, &bc.set, &format!("{f}.set"), case)?;
+        if let Some((n, b)) = nodes.iter().find_map(|&n| body_of[n].map(|b| (n, b))) {
+            return Err(field_error(
+                case,
+                &format!("{f}.set"),
+                format!(
+                    "node {n} moves with structure.rigid_bodies[{b}]; constrain its reference \
+                     node, set \"{}_reference\"",
+                    s.rigid_bodies[b].set
+                ),
+            ));
+        }
+        if !bc.fixed.is_empty() {
+            let mut mask = [false; 6];
+            bc.fixed.iter().for_each(|d| mask[d.index()] = true);
+            fe.fix(&nodes, mask);
+        }
+        match bc.symmetry {
+            Some(Symmetry::Axis(axis)) => fe.symmetry(&nodes, axis.index()),
+            Some(Symmetry::Normal(n)) => skew.push((format!("{f}.symmetry"), nodes.clone(), n)),
+            None => {}
+        }
+        if let Some(p) = &bc.prescribed {
+            fe.prescribe(
+                &nodes,
+                p.dof.index(),
+                p.value,
+                curve(p.curve.as_ref(), default_curve.clone()),
+            );
+        }
+    }
+    // planes of any normal after the fixed and prescribed dofs they combine with
+    for (f, nodes, n) in skew {
+        fe.symmetry_plane(&nodes, n).map_err(|e| field_error(case, &f, e))?;
+    }
+    for (k, l) in s.loads.iter().enumerate() {
+        let f = format!("structure.loads[{k}]");
+        let c = curve(l.curve.as_ref(), default_curve.clone());
+        match l.kind().expect("validated") {
+            LoadKind::Point { set, dof, value } => {
+                for n in node_set(&mesh, set, &format!("{f}.set"), case)? {
+                    fe.point_load(n, dof.index(), value, c.clone());
+                }
+            }
+            LoadKind::Pressure { set, p } => {
+                let face =
+                    |c: &usize| matches!(mesh.cells[*c].kind, CellKind::Tri3 | CellKind::Quad4);
+                let cells = match set {
+                    Some(name) => cell_set(&mesh, name, &format!("{f}.set"), case)?,
+                    None => kept.iter().copied().filter(face).collect(),
+                };
+                if cells.is_empty() {
+                    return Err(field_error(
+                        case,
+                        &format!("{f}.pressure"),
+                        "the model has no shell",
+                    ));
+                }
+                if let Some(bad) = cells.iter().find(|c| !face(c) || model_cell[**c].is_none()) {
+                    return Err(field_error(
+                        case,
+                        &format!("{f}.set"),
+                        format!(
+                            "a pressure acts on the shells of a part; cell {bad} is a {:?}{}",
+                            mesh.cells[*bad].kind,
+                            if model_cell[*bad].is_none() { " of no part" } else { "" }
+                        ),
+                    ));
+                }
+                let cells: Vec<usize> = cells.iter().filter_map(|&c| model_cell[c]).collect();
+                fe.pressure(&cells, p, c);
+            }
+            LoadKind::Gravity(g) => fe.gravity(g, c),
+        }
+    }
+    let mut v0 = vec![0.0; fe.n_dof()];
+    for (k, iv) in s.initial_velocity.iter().enumerate() {
+        let f = format!("structure.initial_velocity[{k}].set");
+        for node in node_set(&mesh, &iv.set, &f, case)? {
+            v0[6 * node + iv.dof.index()] = iv.value;
+        }
+    }
+    for (v, &c) in v0.iter_mut().zip(fe.constrained()) {
+        if c {
+            *v = 0.0;
+        }
+    }
+    let is_bt4 = |c: &usize| matches!(parts[*c], Some(Part::Bt4(..)));
+    let cells = CellMap {
+        elements: kept.iter().copied().filter(|c| !is_bt4(c)).collect(),
+        bt4: kept.iter().copied().filter(is_bt4).collect(),
+        n_cells: mesh.cells.len(),
+    };
+    let thinnest = parts
+        .iter()
+        .flatten()
+        .filter_map(|p| match p {
+            Part::Shell(s) | Part::ShellJ2(s, _) | Part::Bt4(s, _) => Some(s.h),
+            _ => None,
+        })
+        .fold(f64::INFINITY, f64::min);
+    let length =
+        if thinnest.is_finite() { thinnest } else { 1e-3 * validate::diagonal(&mesh.nodes) };
+    Ok(Structure { mesh, model: fe, v0, cells, length })
+}
+
+/// The `[structure]` section of a case, or an error naming the file.
+pub fn section(case: &Case) -> anyhow::Result<&StructureSection> {
+    case.structure.as_ref().ok_or_else(|| {
+        anyhow!(
+            "{}: a `[structure]` section is required to run structure-solver",
+            case.source.path.display()
+        )
+    })
+}
