@@ -37,7 +37,8 @@ enum Cmd {
         #[arg(long)]
         run_id: Option<String>,
     },
-    /// Parses and validates a case without running it.
+    /// Validates a case without running it: the launcher's keys, then each participant's own
+    /// `check` (mesh, sets, EOS, states, probes).
     Check {
         /// The case file (TOML).
         case: PathBuf,
@@ -88,9 +89,19 @@ fn main() -> ExitCode {
             }
         }
         Cmd::Check { case, overrides } => match check::check(&case, &overrides) {
-            Ok(summary) => {
-                print!("{summary}");
-                ExitCode::SUCCESS
+            Ok(report) => {
+                print!("{}", report.summary);
+                for w in &report.warnings {
+                    eprintln!("fsi: warning: {w}");
+                }
+                for e in &report.errors {
+                    eprintln!("fsi: error: {e}");
+                }
+                if report.errors.is_empty() {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::from(2)
+                }
             }
             Err(e) => {
                 eprintln!("fsi: error: {e}");

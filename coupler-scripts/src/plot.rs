@@ -13,15 +13,27 @@ pub const PROBE_FILES: &[&str] = &["probes.csv", "structure_probes.csv"];
 pub struct Table {
     pub columns: Vec<String>,
     pub rows: Vec<Vec<f64>>,
+    /// 1-based number of a last line left without its line break (a writer killed mid-row):
+    /// it is not in `rows`.
+    pub cut_line: Option<usize>,
 }
 
-/// Reads a probe CSV (header line, then numbers); errors name the file and line.
+/// Reads a probe CSV (header line, then numbers); errors name the file and line. A last line
+/// without its terminating line break was cut short by a writer that died: it is left out and
+/// reported in [`Table::cut_line`], since even when it parses its last number may be cut.
 pub fn read_csv(path: &Path) -> anyhow::Result<Table> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
-    let (_, header) =
-        lines.next().ok_or_else(|| anyhow::anyhow!("{}: empty file", path.display()))?;
+    let (whole, cut_line) = match text.rfind('\n') {
+        _ if text.is_empty() || text.ends_with('\n') => (text.as_str(), None),
+        Some(i) => (&text[..=i], Some(text[..=i].matches('\n').count() + 1)),
+        None => ("", Some(1)),
+    };
+    let mut lines = whole.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let (_, header) = lines.next().ok_or_else(|| match cut_line {
+        Some(_) => anyhow::anyhow!("{}:1: the header line is cut short", path.display()),
+        None => anyhow::anyhow!("{}: empty file", path.display()),
+    })?;
     let columns: Vec<String> = header.split(',').map(|c| c.trim().to_string()).collect();
     let mut rows = Vec::new();
     for (i, line) in lines {
@@ -40,7 +52,19 @@ pub fn read_csv(path: &Path) -> anyhow::Result<Table> {
         );
         rows.push(row);
     }
-    Ok(Table { columns, rows })
+    Ok(Table { columns, rows, cut_line })
+}
+
+/// The warning for a table whose last line was cut, naming the file and line.
+pub fn cut_warning(path: &Path, table: &Table) -> Option<String> {
+    table.cut_line.map(|line| {
+        format!(
+            "{}:{line}: the last line is cut short (the writer stopped mid-row); plotting the {} \
+             whole rows before it",
+            path.display(),
+            table.rows.len()
+        )
+    })
 }
 
 /// Writes `plots/<file stem>-<column>.png` in `dir` for every probe column; returns the files.
@@ -59,6 +83,9 @@ pub fn plot_dir(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
         .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", plots.display()))?;
     for file in found {
         let table = read_csv(&file)?;
+        if let Some(w) = cut_warning(&file, &table) {
+            eprintln!("fsi: warning: {w}");
+        }
         let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         for c in 1..table.columns.len() {
             let name = table.columns[c].replace(['/', ' '], "_");
@@ -85,15 +112,81 @@ fn plot_column(table: &Table, c: usize, png: &Path) -> anyhow::Result<()> {
         .y_label_area_size(80)
         .build_cartesian_2d(t0..t1, y0..y1)
         .map_err(|e| draw(&e))?;
+    let (x_ticks, y_ticks) = (TickFormat::for_range(t0, t1), TickFormat::for_range(y0, y1));
     chart
         .configure_mesh()
-        .x_desc(table.columns[0].as_str())
-        .y_desc(table.columns[c].as_str())
+        .x_desc(axis_label(&table.columns[0]))
+        .y_desc(axis_label(&table.columns[c]))
+        .x_label_formatter(&|v| x_ticks.label(*v))
+        .y_label_formatter(&|v| y_ticks.label(*v))
         .draw()
         .map_err(|e| draw(&e))?;
     chart.draw_series(LineSeries::new(points, &BLUE)).map_err(|e| draw(&e))?;
     root.present().map_err(|e| draw(&e))?;
     Ok(())
+}
+
+/// The unit of a probe column from its component name (`<probe>.<component>` or `time`).
+pub fn unit(column: &str) -> Option<&'static str> {
+    match column.rsplit('.').next().unwrap_or(column) {
+        "time" | "t" => Some("s"),
+        "rho" => Some("kg/m³"),
+        "vx" | "vy" | "vz" => Some("m/s"),
+        "p" => Some("Pa"),
+        "ux" | "uy" | "uz" => Some("m"),
+        _ => None,
+    }
+}
+
+/// `piston.ux [m]`, or the bare name when the unit is unknown.
+pub fn axis_label(column: &str) -> String {
+    match unit(column) {
+        Some(u) => format!("{column} [{u}]"),
+        None => column.to_string(),
+    }
+}
+
+/// Tick labels of one axis in engineering notation (`-6.70e-6`, `100.02e3`): the exponent a
+/// multiple of 3 fixed by the largest magnitude on the axis, with at least 3 significant digits
+/// and enough decimals to tell ticks a tenth of the range apart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TickFormat {
+    exp: i32,
+    decimals: usize,
+}
+
+impl TickFormat {
+    /// The format for an axis from `lo` to `hi`.
+    pub fn for_range(lo: f64, hi: f64) -> TickFormat {
+        let big = lo.abs().max(hi.abs());
+        if !big.is_finite() || big == 0.0 {
+            return TickFormat { exp: 0, decimals: 1 };
+        }
+        let lead = big.log10().floor() as i32;
+        let exp = 3 * lead.div_euclid(3);
+        // 3 significant digits of the largest value...
+        let mut decimals = 2 - (lead - exp);
+        // ...and the leading digit of a tenth of the span.
+        let step = (hi - lo).abs() / 10.0;
+        if step.is_finite() && step > 0.0 {
+            decimals = decimals.max(exp - step.log10().floor() as i32);
+        }
+        TickFormat { exp, decimals: decimals.clamp(0, 12) as usize }
+    }
+
+    /// The label of `v`; a value that rounds to zero is `0`, never `-0.0`.
+    pub fn label(&self, v: f64) -> String {
+        let m = v / 10f64.powi(self.exp);
+        let text = format!("{m:.*}", self.decimals);
+        if text.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+            return "0".to_string();
+        }
+        if self.exp == 0 {
+            text
+        } else {
+            format!("{text}e{}", self.exp)
+        }
+    }
 }
 
 /// Finite min and max of `values`, widened when flat or empty so the axis is never degenerate.
@@ -139,6 +232,64 @@ mod tests {
         let empty = tempfile::tempdir().unwrap();
         let e = plot_dir(empty.path()).unwrap_err().to_string();
         assert!(e.contains("no probe file"), "{e}");
+    }
+
+    #[test]
+    fn a_cut_last_line_is_left_out_with_a_warning_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("structure_probes.csv");
+        // The last row stopped inside its last number: it even parses, to a wrong value.
+        let text = "time,piston.ux\n0,1e-3\n0.001,2e-3\n0.002,3.0";
+        std::fs::write(&path, text).unwrap();
+        let table = read_csv(&path).unwrap();
+        assert_eq!(table.rows, vec![vec![0.0, 1e-3], vec![0.001, 2e-3]]);
+        assert_eq!(table.cut_line, Some(4));
+        let w = cut_warning(&path, &table).unwrap();
+        assert!(w.contains("structure_probes.csv:4") && w.contains("cut short"), "{w}");
+        assert_eq!(plot_dir(dir.path()).unwrap().len(), 1);
+        // Cut in the middle of a row: the same.
+        std::fs::write(&path, "time,piston.ux\n0,1e-3\n0.00").unwrap();
+        assert_eq!(read_csv(&path).unwrap().cut_line, Some(3));
+        assert_eq!(plot_dir(dir.path()).unwrap().len(), 1);
+        // A whole file has no warning; a bad row that is whole stays an error.
+        std::fs::write(&path, "time,piston.ux\n0,1e-3\n").unwrap();
+        let table = read_csv(&path).unwrap();
+        assert_eq!((table.rows.len(), cut_warning(&path, &table)), (1, None));
+        std::fs::write(&path, "time,piston.ux\n0,1e-3\n0.1\n").unwrap();
+        let e = read_csv(&path).unwrap_err().to_string();
+        assert!(e.contains("structure_probes.csv:3"), "{e}");
+        std::fs::write(&path, "time,pis").unwrap();
+        let e = read_csv(&path).unwrap_err().to_string();
+        assert!(e.contains("structure_probes.csv:1") && e.contains("header"), "{e}");
+    }
+
+    #[test]
+    fn small_ticks_are_not_rounded_to_zero() {
+        let f = TickFormat::for_range(-7e-6, 0.0);
+        assert_eq!(f.label(-6.7e-6), "-6.70e-6");
+        assert_eq!(f.label(-1e-6), "-1.00e-6");
+        assert_eq!(f.label(-1e-22), "0");
+        assert_eq!(f.label(0.0), "0");
+        // Big values with small changes: every tick a tenth of the span apart stays distinct.
+        let f = TickFormat::for_range(99_999.0, 100_001.0);
+        let labels: Vec<String> = (0..=10).map(|i| f.label(99_999.0 + 0.2 * i as f64)).collect();
+        assert_eq!(labels[0], "99.9990e3");
+        for w in labels.windows(2) {
+            assert_ne!(w[0], w[1], "{labels:?}");
+        }
+        assert_eq!(TickFormat::for_range(0.0, 1.0).label(0.5), "0.50");
+        assert_eq!(TickFormat::for_range(-0.45, 0.45).label(-0.45), "-450e-3");
+        assert_eq!(TickFormat::for_range(0.0, 0.0).label(0.0), "0");
+    }
+
+    #[test]
+    fn axes_carry_the_unit_of_their_column() {
+        assert_eq!(axis_label("time"), "time [s]");
+        assert_eq!(axis_label("face.rho"), "face.rho [kg/m³]");
+        assert_eq!(axis_label("face.vz"), "face.vz [m/s]");
+        assert_eq!(axis_label("face.p"), "face.p [Pa]");
+        assert_eq!(axis_label("piston.uy"), "piston.uy [m]");
+        assert_eq!(axis_label("tip.sxx"), "tip.sxx");
     }
 
     #[test]

@@ -3,8 +3,11 @@
 //! The launcher opens the run's services, starts both participants, waits for and checks their
 //! `Hello`s, then sends the scheme's commands one by one. Every wait is cut into slices of
 //! [`SLICE`]; between slices it polls both children and its own termination signals, so a dead
-//! participant, a silent one or Ctrl-C ends the run within about a second, with both children
-//! gone and the run's shared memory removed.
+//! participant, a silent one, Ctrl-C, SIGTERM or SIGHUP ends the run within about a second, with
+//! both children gone, the run's shared memory removed and `run.json` saying why.
+//!
+//! The run id is claimed first ([`shm::RunLock`]): a second launcher given the same id is refused
+//! before it touches anything of the live run.
 
 use crate::scheme::{scheme_name, Progress, SchemeError, SchemeSettings, Sequencer};
 use crate::supervise::{Death, LaunchArgs, Participant, Participants, SpawnError};
@@ -52,8 +55,8 @@ pub enum RunError {
     Spawn(#[from] SpawnError),
     #[error("{death} before the run finished{}", waiting.as_deref().map(|w| format!(", while waiting for {w}")).unwrap_or_default())]
     Died { death: Death, waiting: Option<String> },
-    #[error("{who} did not {what} within {timeout_s} s (coupling.timeout_s)")]
-    Silent { who: String, what: String, timeout_s: f64 },
+    #[error("{who} did not {what} within {timeout_s} s (coupling.timeout_s){note}")]
+    Silent { who: String, what: String, timeout_s: f64, note: String },
     #[error("{0}")]
     Protocol(#[from] ProtocolError),
     #[error("stopped by {}", crate::supervise::signal_name(*.0))]
@@ -135,6 +138,8 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
 
     let run_id = opts.run_id.clone().unwrap_or_else(new_run_id);
     interface_protocol::services::validate_run_id(&run_id)?;
+    // Before anything is created or removed: a live run with this id stays untouched.
+    let _claim = shm::RunLock::acquire(&run_id)?;
     let dir = match (&opts.out, &case.output.dir) {
         (Some(d), _) => d.clone(),
         // Relative to the case file, as the participants read it.
@@ -194,7 +199,8 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     drop(session);
     let wall = start.elapsed();
     let status = match (&result, &cleaned) {
-        (Err(e), _) => e.to_string(),
+        (Err(e @ RunError::Interrupted(_)), _) => format!("interrupted: {e}"),
+        (Err(e), _) => format!("failed: {e}"),
         (Ok(()), Err(e)) => format!("completed, but the run's shared memory was not removed: {e}"),
         (Ok(()), Ok(_)) => "completed".to_string(),
     };
@@ -247,8 +253,7 @@ impl Session<'_> {
             let reply = self.command(role, &cmd)?;
             let progress = match seq.accept(role, &reply) {
                 Err(e @ SchemeError::Failed { .. }) => {
-                    self.children.release(role);
-                    self.finish_other(role);
+                    self.finish_after_failure(role, cmd.kind);
                     return Err(e.into());
                 }
                 other => other?,
@@ -282,11 +287,18 @@ impl Session<'_> {
         reply
     }
 
-    /// After `failed` answered `Failed`: `Finish` to the other participant, best effort.
-    fn finish_other(&mut self, failed: Role) {
+    /// After `failed` answered `Failed` to a command of `kind`: `Finish` to the other participant
+    /// (unless it finished already), then to the failed one (unless `Finish` is what failed), so
+    /// that both flush their outputs and exit; best effort. The failed one may also just exit.
+    fn finish_after_failure(&mut self, failed: Role, kind: u32) {
+        use interface_protocol::messages::command_kind::FINISH;
+        self.children.release(failed);
         let other = if failed == Role::Fluid { Role::Structure } else { Role::Fluid };
-        if self.command(other, &Command::finish()).is_ok() {
+        if !self.children.is_released(other) && self.command(other, &Command::finish()).is_ok() {
             self.children.release(other);
+        }
+        if kind != FINISH {
+            let _ = self.command(failed, &Command::finish());
         }
         self.children.wait_all(Instant::now() + Duration::from_secs(1));
     }
@@ -313,6 +325,7 @@ impl Session<'_> {
                     who: who.join(" and "),
                     what: "exit after Finish".into(),
                     timeout_s: self.timeout_s,
+                    note: String::new(),
                 });
             }
         }
@@ -371,15 +384,30 @@ impl Session<'_> {
                 }
                 Err(e) => return Err(e.into()),
             }
-            match self.check_alive() {
-                Err(RunError::Died { death, .. }) => {
-                    let waiting = (death.role != role).then(|| format!("{who} to {what}"));
-                    return Err(RunError::Died { death, waiting });
+            // A death ends the wait; so does the exit of an awaited participant that was
+            // released (it failed) and will not answer.
+            let death = match self.check_alive() {
+                Err(RunError::Died { death, .. }) => Some(death),
+                other => {
+                    other?;
+                    self.children.exited(role)
                 }
-                other => other?,
+            };
+            if let Some(death) = death {
+                if death.role == role {
+                    // Its answer, sent just before it exited, may have arrived since the read.
+                    let link = self.link.as_mut().expect("the link is open while waiting");
+                    if let Ok(v) = wait(link, Instant::now()) {
+                        return Ok(v);
+                    }
+                }
+                let waiting = (death.role != role).then(|| format!("{who} to {what}"));
+                return Err(RunError::Died { death, waiting });
             }
             if Instant::now() >= deadline {
-                return Err(RunError::Silent { who, what, timeout_s: self.timeout_s });
+                let note =
+                    self.children.get(role).and_then(|p| p.stopped_note()).unwrap_or_default();
+                return Err(RunError::Silent { who, what, timeout_s: self.timeout_s, note });
             }
         }
     }

@@ -10,15 +10,19 @@
 //! for n in 0..N:  S Advance PREDICT [t^n, t^{n+1}];  F Advance NONE [fluid interval n];
 //!                 S Advance CORRECT [t^n, t^{n+1}];
 //!                 if checkpoint_every > 0 and (n+1) % checkpoint_every == 0:
-//!                     S Checkpoint "step-<n+1>";  F Checkpoint "step-<n+1>"
+//!                     S Checkpoint tag;  F Checkpoint tag   (tag = tag_for_step(n+1))
 //! S Finish;  F Finish
 //! ```
+//!
+//! The checkpoint tag is [`checkpoint::tag_for_step`] (`step_0000000100`), the folder name a
+//! solver run alone writes too, so coupled and lone runs name checkpoints one way.
 //!
 //! The fluid interval of step n ends where the structure predicted the wall for, with the step's
 //! own Δt_n: CSS t^{n+1}; C0 t^{n+1} + Δt_n/2 (fluid half a step ahead); A6 t^n + Δt_n/2. It starts
 //! where the previous one ended (CSS t^n, C0 Δt_0/2 after the start-up half step, A6 0).
 
 use interface_protocol::case::{Case, Scheme};
+use interface_protocol::io::checkpoint;
 use interface_protocol::messages::{command_kind, reply_kind, scheme_phase, Command, Reply, Role};
 
 /// A reply that stops the run, or a reply that does not fit the command it answers.
@@ -182,8 +186,8 @@ impl Sequencer {
             Stage::Correct(n) => {
                 (Role::Structure, Command::advance(n, self.time(n), self.time(n + 1), CORRECT))
             }
-            Stage::CheckpointStructure(k) => (Role::Structure, checkpoint(k, self.time(k))),
-            Stage::CheckpointFluid(k) => (Role::Fluid, checkpoint(k, self.time(k))),
+            Stage::CheckpointStructure(k) => (Role::Structure, checkpoint_command(k, self.time(k))),
+            Stage::CheckpointFluid(k) => (Role::Fluid, checkpoint_command(k, self.time(k))),
             Stage::FinishStructure => (Role::Structure, finish),
             Stage::FinishFluid => (Role::Fluid, finish),
             Stage::Over => return None,
@@ -261,9 +265,10 @@ impl Sequencer {
     }
 }
 
-/// `Checkpoint { tag: "step-<k>" }` after k completed steps, at t^k.
-fn checkpoint(k: u64, t: f64) -> Command {
-    Command { step: k, t_from: t, t_to: t, ..Command::checkpoint(&format!("step-{k}")) }
+/// `Checkpoint { tag: tag_for_step(k) }` after k completed steps, at t^k.
+fn checkpoint_command(k: u64, t: f64) -> Command {
+    let tag = checkpoint::tag_for_step(k);
+    Command { step: k, t_from: t, t_to: t, ..Command::checkpoint(&tag) }
 }
 
 #[cfg(test)]

@@ -75,18 +75,54 @@ pub struct Participant {
     released: bool,
 }
 
+/// The participant's program with its own command words, in its own process group and asking
+/// for SIGTERM when `fsi` dies; the caller adds the verb and its arguments.
+pub fn participant_command(
+    role: Role,
+    command: &[String],
+) -> Result<(String, PathBuf, std::process::Command), SpawnError> {
+    let (name, extra) = command.split_first().ok_or(SpawnError::EmptyCommand {
+        section: role.name(),
+        default: if role == Role::Fluid { "fluid-solver" } else { "structure-solver" },
+    })?;
+    let program = resolve_program(name, role)?;
+    let mut cmd = std::process::Command::new(&program);
+    cmd.args(extra);
+    let launcher = std::process::id();
+    cmd.process_group(0);
+    // SAFETY: the closure runs in the forked child before exec and calls only `prctl` and
+    // `getppid`, both async-signal-safe; it allocates nothing and touches no lock.
+    unsafe {
+        cmd.pre_exec(move || {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM as libc::c_ulong, 0, 0, 0) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            // The launcher died between fork and prctl: the signal would never come.
+            if libc::getppid() as u32 != launcher {
+                return Err(std::io::Error::other("the launcher exited during start-up"));
+            }
+            Ok(())
+        });
+    }
+    Ok((name.clone(), program, cmd))
+}
+
+/// Sends `signal` to the process group `pgid` (a child started by `participant_command`, and
+/// anything it started). Call it only for a child not reaped yet, whose pid cannot be reused.
+pub fn signal_group(pgid: u32, signal: libc::c_int) {
+    // SAFETY: `killpg` only sends a signal; the group is the child's own (process_group(0)), and
+    // the caller guarantees the child is not reaped yet.
+    unsafe {
+        libc::killpg(pgid as libc::pid_t, signal);
+    }
+}
+
 impl Participant {
     /// Starts `command` (the case's `[<role>] command`) as
     /// `<command...> run <case> --couple <run_id> --out <dir> [--set k=v]...`.
     pub fn spawn(role: Role, command: &[String], args: &LaunchArgs) -> Result<Self, SpawnError> {
-        let (name, extra) = command.split_first().ok_or(SpawnError::EmptyCommand {
-            section: role.name(),
-            default: if role == Role::Fluid { "fluid-solver" } else { "structure-solver" },
-        })?;
-        let program = resolve_program(name, role)?;
-        let mut cmd = std::process::Command::new(&program);
-        cmd.args(extra)
-            .arg("run")
+        let (name, program, mut cmd) = participant_command(role, command)?;
+        cmd.arg("run")
             .arg(args.case_file)
             .arg("--couple")
             .arg(args.run_id)
@@ -95,29 +131,13 @@ impl Participant {
         for o in args.overrides {
             cmd.arg("--set").arg(o);
         }
-        let launcher = std::process::id();
-        cmd.env(LAUNCHER_PID_ENV, launcher.to_string()).process_group(0);
-        // SAFETY: the closure runs in the forked child before exec and calls only `prctl` and
-        // `getppid`, both async-signal-safe; it allocates nothing and touches no lock.
-        unsafe {
-            cmd.pre_exec(move || {
-                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM as libc::c_ulong, 0, 0, 0) != 0
-                {
-                    return Err(std::io::Error::last_os_error());
-                }
-                // The launcher died between fork and prctl: the signal would never come.
-                if libc::getppid() as u32 != launcher {
-                    return Err(std::io::Error::other("the launcher exited during start-up"));
-                }
-                Ok(())
-            });
-        }
+        cmd.env(LAUNCHER_PID_ENV, std::process::id().to_string());
         let child = cmd.spawn().map_err(|source| SpawnError::Spawn {
             role: role.name(),
             program: program.display().to_string(),
             source,
         })?;
-        Ok(Participant { role, program: name.clone(), child, exit: None, released: false })
+        Ok(Participant { role, program: name, child, exit: None, released: false })
     }
 
     pub fn pid(&self) -> u32 {
@@ -135,12 +155,18 @@ impl Participant {
     /// Sends `signal` to the child's process group (the child and anything it started).
     fn signal(&self, signal: libc::c_int) {
         if self.exit.is_none() {
-            // SAFETY: `killpg` only sends a signal; the group is the child's own (process_group(0)),
-            // and the child is not reaped yet, so its pid cannot have been reused.
-            unsafe {
-                libc::killpg(self.child.id() as libc::pid_t, signal);
-            }
+            signal_group(self.child.id(), signal);
         }
+    }
+
+    /// "; its process is stopped (SIGSTOP or a debugger)" when the kernel says so, for the message
+    /// about a participant that did not answer.
+    pub fn stopped_note(&self) -> Option<String> {
+        let stat = std::fs::read_to_string(format!("/proc/{}/stat", self.pid())).ok()?;
+        // The state follows the parenthesised command name.
+        let state = stat.rsplit(')').next()?.split_whitespace().next()?;
+        matches!(state, "T" | "t")
+            .then(|| "; its process is stopped (SIGSTOP or a debugger)".into())
     }
 
     /// "rigid-structure (structure, pid 123)".
@@ -207,6 +233,11 @@ impl Participants {
         self.list.iter().find(|p| p.role == role)
     }
 
+    /// Whether the participant of `role` was released (it finished, or failed).
+    pub fn is_released(&self, role: Role) -> bool {
+        self.list.iter().any(|p| p.role == role && p.released)
+    }
+
     /// Lets the participant of `role` exit from now on without that counting as a death.
     pub fn release(&mut self, role: Role) {
         self.list.iter_mut().filter(|p| p.role == role).for_each(|p| p.released = true);
@@ -226,6 +257,13 @@ impl Participants {
             }
         }
         dead
+    }
+
+    /// How the participant of `role` ended, if it did (released or not).
+    pub fn exited(&mut self, role: Role) -> Option<Death> {
+        let p = self.list.iter_mut().find(|p| p.role == role)?;
+        let status = p.poll()?;
+        Some(Death { role, label: p.label(), how: describe_exit(status) })
     }
 
     /// Waits until every child has exited, until `deadline`; returns the ones still running.

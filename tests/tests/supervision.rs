@@ -1,6 +1,8 @@
-//! The launcher's supervision through real processes: a participant killed, `fsi` killed, a
-//! handshake refused, a participant that never starts or stops answering. Each ends with a clear
-//! error within its deadline, no process left and no shared-memory file of the run remaining.
+//! The launcher's supervision through real processes: a participant killed or stopped, `fsi`
+//! killed or hung up, a handshake refused, a participant that never starts, one that answers
+//! `Failed`, a run id used twice. Each ends with a clear error within its deadline, no process
+//! left and no shared-memory file of the run remaining. Every case here has `timeout_s <= 2`;
+//! `scripts/fault-loop` runs this file repeatedly.
 
 use fsi_system_tests::{
     alive, run_files, signal, unique_run_id, wait_gone, Finished, Fsi, Scratch,
@@ -10,7 +12,12 @@ use std::time::{Duration, Instant};
 
 /// A piston case that would run for hours: it only ends when a test ends it.
 fn endless_case(scratch: &Scratch, timeout_s: f64) -> PathBuf {
-    let text = format!(
+    scratch.case("endless", &endless_case_text(timeout_s))
+}
+
+/// The text of `endless_case`.
+fn endless_case_text(timeout_s: f64) -> String {
+    format!(
         r#"[coupling]
 scheme = "C0"
 dt = 1e-5
@@ -30,8 +37,7 @@ mass = 1.0
 stiffness = 3947.8
 probe = "piston"
 "#
-    );
-    scratch.case("endless", &text)
+    )
 }
 
 /// A case with the given participant commands (TOML arrays) and timeout.
@@ -102,7 +108,7 @@ fn assert_no_run_files(run_id: &str) {
 /// other participant is gone and no file of the run remains.
 fn kill_participant(victim: &str, survivor: &str) {
     let scratch = Scratch::new();
-    let case = endless_case(&scratch, 10.0);
+    let case = endless_case(&scratch, 2.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
@@ -130,9 +136,9 @@ fn killing_the_fluid_stops_the_run_within_a_second() {
 }
 
 #[test]
-fn killing_fsi_ends_both_participants_within_a_second() {
+fn killing_fsi_ends_both_participants_and_a_later_run_removes_its_files() {
     let scratch = Scratch::new();
-    let case = endless_case(&scratch, 10.0);
+    let case = endless_case(&scratch, 2.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
@@ -141,42 +147,87 @@ fn killing_fsi_ends_both_participants_within_a_second() {
     signal(fsi.pid(), libc::SIGKILL);
     let gone = wait_gone(&pids, Duration::from_secs(5));
     let _ = fsi.wait(Duration::from_secs(5));
-    // Nobody is left to remove the run's files: the next launcher removes stale runs; here the
-    // test does, so nothing accumulates.
-    let _ = interface_protocol::shm::cleanup_run(&run_id);
     let gone =
         gone.unwrap_or_else(|| panic!("participants {kids:?} still alive 5 s after fsi died"));
     println!("fsi killed: participants gone {gone:?} later");
     assert!(gone < Duration::from_secs(1), "participants took {gone:?} to exit");
+    // Nobody was left to remove the run's files (its lock and iceoryx2's global_mgmt at least):
+    // the next launcher, whatever its run id, removes every one of them at once.
+    let left = run_files(&run_id);
+    assert!(!left.is_empty(), "a killed fsi left no file: the test proves nothing");
+    let later = quick_case(&scratch, "later");
+    let done = Fsi::run(&scratch, &later, &scratch.path().join("later"), &[]).wait(LIMIT);
+    assert!(done.status.success(), "the later run failed:\n{}", done.stderr);
+    let still = run_files(&run_id);
+    // Leave nothing behind even when the assertion fails.
+    let _ = interface_protocol::shm::cleanup_run(&run_id);
+    assert!(still.is_empty(), "the later run left files of the dead run: {still:?} (of {left:?})");
 }
 
-#[test]
-fn sigterm_to_fsi_stops_both_participants_cleanly() {
+/// `signal` to fsi: it exits with 128 + signal, naming it; both participants are gone, no file
+/// of the run remains and `run.json` says the run was interrupted and by what.
+fn stop_fsi_with(signal_number: i32, name: &str) {
     let scratch = Scratch::new();
-    let case = endless_case(&scratch, 10.0);
+    let case = endless_case(&scratch, 2.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
     let kids = running(&fsi, &out);
-    signal(fsi.pid(), libc::SIGTERM);
+    signal(fsi.pid(), signal_number);
     let done = fsi.wait(Duration::from_secs(5));
-    println!("fsi got SIGTERM: exited after {:?}: {}", done.elapsed, done.stderr.trim());
-    assert_eq!(done.status.code(), Some(128 + libc::SIGTERM), "{}", done.stderr);
-    assert!(done.stderr.contains("stopped by SIGTERM"), "{}", done.stderr);
+    println!("fsi got {name}: exited after {:?}: {}", done.elapsed, done.stderr.trim());
+    assert_eq!(done.status.code(), Some(128 + signal_number), "{}", done.stderr);
+    let why = format!("stopped by {name}");
+    assert!(done.stderr.contains(&why), "{}", done.stderr);
     for (pid, name) in &kids {
         assert!(!alive(*pid), "{name} (pid {pid}) survived");
     }
     assert_no_run_files(&run_id);
-    // run.json says why the run stopped.
     let report = std::fs::read_to_string(out.join("run.json")).expect("run.json");
-    assert!(report.contains("stopped by SIGTERM"), "{report}");
+    assert_eq!(status_of(&report), format!("interrupted: {why}"), "{report}");
+}
+
+#[test]
+fn sigterm_to_fsi_stops_both_participants_cleanly() {
+    stop_fsi_with(libc::SIGTERM, "SIGTERM");
+}
+
+#[test]
+fn sighup_to_fsi_stops_both_participants_cleanly() {
+    stop_fsi_with(libc::SIGHUP, "SIGHUP");
+}
+
+#[test]
+fn a_second_run_with_the_same_id_is_refused_and_the_first_finishes_untouched() {
+    let scratch = Scratch::new();
+    // About 1e4 steps: long enough to be running while the second launcher tries.
+    let case = scratch.case("first", &endless_case_text(2.0).replace("t_end = 1e3", "t_end = 0.1"));
+    let out = scratch.path().join("first");
+    let first = Fsi::run(&scratch, &case, &out, &[]);
+    let run_id = first.run_id.clone();
+    running(&first, &out);
+    let second_out = scratch.path().join("second");
+    let args = ["run", case.to_str().unwrap(), "--out", second_out.to_str().unwrap(), "--quiet"];
+    let second = Fsi::start(&scratch, &[&args[..], &["--run-id", &run_id]].concat());
+    let refused = second.wait(Duration::from_secs(5));
+    println!("second launcher: exited after {:?}: {}", refused.elapsed, refused.stderr.trim());
+    let want = format!("run id {run_id} is in use by pid {}", first.pid());
+    assert_failed_naming(&refused, &[&want]);
+    assert!(refused.elapsed < Duration::from_secs(1), "refused after {:?}", refused.elapsed);
+    assert!(!second_out.exists(), "the refused run created its output folder");
+    let done = first.wait(LIMIT);
+    assert!(done.status.success(), "the first run failed:\n{}", done.stderr);
+    assert!(done.stderr.trim().is_empty(), "the first run printed:\n{}", done.stderr);
+    let report = std::fs::read_to_string(out.join("run.json")).expect("run.json");
+    assert_eq!(status_of(&report), "completed");
+    assert_no_run_files(&run_id);
 }
 
 #[test]
 fn a_protocol_version_mismatch_is_refused_naming_both_versions() {
     let scratch = Scratch::new();
     let stub = r#"["fake-participant", "--role", "structure", "--protocol-version", "99"]"#;
-    let case = case_with(&scratch, "version", r#"["piston-fluid"]"#, stub, 5.0);
+    let case = case_with(&scratch, "version", r#"["piston-fluid"]"#, stub, 2.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
@@ -191,7 +242,7 @@ fn a_protocol_version_mismatch_is_refused_naming_both_versions() {
 fn a_node_count_mismatch_is_refused_naming_both_counts() {
     let scratch = Scratch::new();
     let stub = r#"["fake-participant", "--role", "fluid", "--nodes", "5"]"#;
-    let case = case_with(&scratch, "nodes", stub, r#"["rigid-structure"]"#, 5.0);
+    let case = case_with(&scratch, "nodes", stub, r#"["rigid-structure"]"#, 2.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
@@ -225,7 +276,7 @@ fn a_participant_that_never_sends_hello_is_named_after_the_timeout() {
 fn a_missing_participant_binary_is_named_at_once() {
     let scratch = Scratch::new();
     let case =
-        case_with(&scratch, "missing", r#"["no-such-solver-xyz"]"#, r#"["rigid-structure"]"#, 5.0);
+        case_with(&scratch, "missing", r#"["no-such-solver-xyz"]"#, r#"["rigid-structure"]"#, 2.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
@@ -236,26 +287,30 @@ fn a_missing_participant_binary_is_named_at_once() {
     assert_no_run_files(&run_id);
 }
 
-#[test]
-fn a_participant_that_stops_answering_ends_the_run_after_the_timeout() {
+/// SIGSTOP of one participant: fsi blames it (whose reply is missing), never the other one
+/// (whose own wait for a command is longer than the launcher's for a reply), after the timeout.
+fn stop_participant(victim: &str, other: &str) {
     let scratch = Scratch::new();
-    let timeout_s = 1.5;
+    let timeout_s = 1.0;
     let case = endless_case(&scratch, timeout_s);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
     let kids = running(&fsi, &out);
-    let fluid = pid_of(&kids, "piston-fluid");
+    let v = pid_of(&kids, victim);
     let stopped = Instant::now();
-    signal(fluid, libc::SIGSTOP);
+    signal(v, libc::SIGSTOP);
     let done = fsi.wait(Duration::from_secs(15));
     let after = stopped.elapsed();
-    println!("fluid stopped: fsi exited {after:?} later: {}", done.stderr.trim());
-    // The stopped fluid is named, whether the launcher's wait for it or the structure's wait for
-    // the next command runs out first.
-    assert_failed_naming(&done, &["piston-fluid"]);
+    let error = fsi_error(&done);
+    println!("{victim} stopped: fsi exited {after:?} later: {error}");
+    assert!(!done.status.success(), "fsi succeeded:\n{}", done.stderr);
+    for w in [victim, "did not answer", "its process is stopped"] {
+        assert!(error.contains(w), "the error does not name `{w}`: {error}");
+    }
+    assert!(!error.contains(other), "the error blames {other}: {error}");
     let limit = Duration::from_secs_f64(timeout_s + 2.0);
-    assert!(after < limit, "fsi took {after:?} after the fluid stopped (timeout {timeout_s} s)");
+    assert!(after < limit, "fsi took {after:?} after {victim} stopped (timeout {timeout_s} s)");
     for (pid, name) in &kids {
         assert!(!alive(*pid), "{name} (pid {pid}) survived");
     }
@@ -263,10 +318,20 @@ fn a_participant_that_stops_answering_ends_the_run_after_the_timeout() {
 }
 
 #[test]
+fn a_stopped_fluid_is_blamed_after_the_timeout() {
+    stop_participant("piston-fluid", "rigid-structure");
+}
+
+#[test]
+fn a_stopped_structure_is_blamed_after_the_timeout() {
+    stop_participant("rigid-structure", "piston-fluid");
+}
+
+#[test]
 fn a_failed_reply_finishes_the_other_participant_and_reports_the_message() {
     let scratch = Scratch::new();
     let fluid = r#"["fake-participant", "--role", "fluid", "--fail-init", "mesh file cylinder.msh missing"]"#;
-    let case = case_with(&scratch, "failed", fluid, r#"["rigid-structure"]"#, 5.0);
+    let case = case_with(&scratch, "failed", fluid, r#"["rigid-structure"]"#, 2.0);
     let out = scratch.path().join("out");
     let fsi = Fsi::run(&scratch, &case, &out, &[]);
     let run_id = fsi.run_id.clone();
@@ -277,6 +342,85 @@ fn a_failed_reply_finishes_the_other_participant_and_reports_the_message() {
     // The structure was told to finish, and did: it reports no error of its own.
     assert!(!done.stderr.contains("rigid-structure:"), "{}", done.stderr);
     assert_no_run_files(&run_id);
+    let report = std::fs::read_to_string(out.join("run.json")).expect("run.json");
+    assert!(status_of(&report).starts_with("failed: fluid failed at Init"), "{report}");
+}
+
+/// A `Failed` reply in any phase of the scheme fails the run with the participant's message:
+/// non-zero exit, `run.json` status `failed: ...`, both participants finished.
+#[test]
+fn a_failed_reply_in_any_phase_fails_the_run_with_its_message() {
+    let scratch = Scratch::new();
+    let phases = [
+        ("structure", "init", 0, "Init"),
+        ("fluid", "init", 0, "Init"),
+        ("structure", "start", 0, "Advance START"),
+        ("fluid", "start", 0, "Advance START"),
+        ("structure", "predict", 2, "Advance PREDICT step 2"),
+        ("fluid", "advance", 2, "Advance NONE step 2"),
+        ("structure", "correct", 2, "Advance CORRECT step 2"),
+        ("structure", "checkpoint", 2, "Checkpoint"),
+        ("fluid", "checkpoint", 4, "Checkpoint"),
+        ("structure", "finish", 0, "Finish"),
+        ("fluid", "finish", 0, "Finish"),
+    ];
+    for (role, on, step, command) in phases {
+        let message = format!("state not finite ({role} {on} {step})");
+        let fake = |r: &str| {
+            let mut words = vec!["fake-participant".to_string(), "--role".into(), r.into()];
+            if r == role {
+                let step = step.to_string();
+                words.extend(
+                    ["--fail", &message, "--fail-on", on, "--fail-step", &step].map(String::from),
+                );
+            } else {
+                words.push("--serve".into());
+            }
+            format!("{words:?}")
+        };
+        let text = format!(
+            "[coupling]\nscheme = \"C0\"\ndt = 1e-3\nt_end = 5e-3\ntimeout_s = 2\n\
+             [output]\ncheckpoint_every = 2\n[fluid]\ncommand = {}\n[structure]\ncommand = {}\n",
+            fake("fluid"),
+            fake("structure")
+        );
+        let name = format!("{role}-{on}");
+        let case = scratch.case(&name, &text);
+        let out = scratch.path().join(&name);
+        let fsi = Fsi::run(&scratch, &case, &out, &[]);
+        let run_id = fsi.run_id.clone();
+        let done = fsi.wait(Duration::from_secs(10));
+        let error = fsi_error(&done);
+        println!("{role} failing at {on}: after {:?}: {error}", done.elapsed);
+        let at = format!("{role} failed at {command}");
+        assert_failed_naming(&done, &[&at, &message]);
+        assert!(done.elapsed < Duration::from_secs(3), "{name}: took {:?}", done.elapsed);
+        let report = std::fs::read_to_string(out.join("run.json")).expect("run.json");
+        let status = status_of(&report);
+        assert!(status.starts_with("failed: ") && status.contains(&message), "{name}: {report}");
+        assert_no_run_files(&run_id);
+    }
+}
+
+/// Wait limit of a run that should complete.
+const LIMIT: Duration = Duration::from_secs(30);
+
+/// A coupled piston run of ten steps.
+fn quick_case(scratch: &Scratch, name: &str) -> PathBuf {
+    let text = endless_case_text(2.0).replace("dt = 1e-5\nt_end = 1e3", "dt = 1e-3\nt_end = 1e-2");
+    scratch.case(name, &text)
+}
+
+/// The `status` of a `run.json`.
+fn status_of(report: &str) -> String {
+    let v: serde_json::Value = serde_json::from_str(report).expect("run.json is JSON");
+    v["status"].as_str().expect("a status").to_string()
+}
+
+/// fsi's own error line (`fsi: error: ...`), without the participants' lines around it.
+fn fsi_error(done: &Finished) -> String {
+    let line = done.stderr.lines().find(|l| l.starts_with("fsi: error:"));
+    line.unwrap_or_else(|| panic!("no `fsi: error:` line in:\n{}", done.stderr)).to_string()
 }
 
 #[test]

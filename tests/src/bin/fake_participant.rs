@@ -4,7 +4,13 @@
 //! [--set k=v]...`, the case hash computed from the case like a real participant. Modes:
 //! - `--protocol-version N` / `--nodes N`: publishes one crafted `Hello` and answers nothing;
 //! - `--fail-init MESSAGE`: joins through the real endpoint and answers `Init` with
-//!   `Failed { message }`, then serves the rest of the sequence as a no-op.
+//!   `Failed { message }`, then serves the rest of the sequence as a no-op;
+//! - `--fail MESSAGE --fail-on init|start|predict|advance|correct|checkpoint|finish
+//!   [--fail-step K]`: the same, failing the first such command of step K (default 0;
+//!   `advance` is the fluid's phase-NONE advance);
+//! - `--serve`: joins and answers every command as a no-op (the peer of a scripted failure).
+//!
+//! Serving, it publishes and reads no surface data: pair it with another fake participant.
 //!
 //! It exits on SIGTERM/SIGINT or when the launcher is gone, like any participant.
 
@@ -28,6 +34,14 @@ struct Args {
     nodes: u64,
     #[arg(long)]
     fail_init: Option<String>,
+    #[arg(long)]
+    fail: Option<String>,
+    #[arg(long, default_value = "init")]
+    fail_on: String,
+    #[arg(long, default_value_t = 0)]
+    fail_step: u64,
+    #[arg(long)]
+    serve: bool,
     /// `run`, as every participant is started.
     verb: String,
     case: PathBuf,
@@ -50,40 +64,100 @@ fn main() -> anyhow::Result<()> {
     let case = Case::load(&args.case, &args.overrides)?;
     let info =
         HelloInfo { n_surface_nodes: args.nodes, n_surface_elements: 0, case_hash: case.hash() };
-    match &args.fail_init {
-        Some(message) => fail_init(role, &args.couple, info, &case, message),
-        None => crafted_hello(role, &args.couple, info, args.protocol_version),
+    let fail = match (args.fail_init, args.fail) {
+        (Some(message), _) => Some((When::parse("init", 0)?, message)),
+        (None, Some(message)) => Some((When::parse(&args.fail_on, args.fail_step)?, message)),
+        (None, None) => None,
+    };
+    if fail.is_none() && !args.serve {
+        return crafted_hello(role, &args.couple, info, args.protocol_version);
+    }
+    scripted(role, &args.couple, info, &case, Scripted { fail, steps: 0 })
+}
+
+/// The command a scripted participant fails: its kind, the advance's phase, the step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct When {
+    kind: u32,
+    phase: Option<u32>,
+    step: u64,
+}
+
+impl When {
+    fn parse(on: &str, step: u64) -> anyhow::Result<When> {
+        use interface_protocol::messages::{command_kind as k, scheme_phase as p};
+        let (kind, phase) = match on {
+            "init" => (k::INIT, None),
+            "start" => (k::ADVANCE, Some(p::START)),
+            "predict" => (k::ADVANCE, Some(p::PREDICT)),
+            "advance" => (k::ADVANCE, Some(p::NONE)),
+            "correct" => (k::ADVANCE, Some(p::CORRECT)),
+            "checkpoint" => (k::CHECKPOINT, None),
+            "finish" => (k::FINISH, None),
+            other => anyhow::bail!(
+                "--fail-on: expected init, start, predict, advance, correct, checkpoint or \
+                 finish, got `{other}`"
+            ),
+        };
+        Ok(When { kind, phase, step })
     }
 }
 
-/// Answers `Init` with `Failed`, everything else with `Done`.
-struct FailInit(String);
+/// Answers every command with `Done` (`Ready` for `Init`), but `Failed` at the scripted one.
+struct Scripted {
+    fail: Option<(When, String)>,
+    /// Steps completed (a checkpoint after k steps is the checkpoint of step k).
+    steps: u64,
+}
 
-impl<E> Handler<E> for FailInit {
+impl Scripted {
+    /// `step`: `None` for `Init` and `Finish`, which happen once whatever the step.
+    fn answer(&self, kind: u32, phase: u32, step: Option<u64>) -> Result<(), Failure> {
+        match &self.fail {
+            Some((w, message))
+                if w.kind == kind
+                    && w.phase.is_none_or(|p| p == phase)
+                    && step.is_none_or(|s| s == w.step) =>
+            {
+                Err(Failure::new(failure_code::SOLVER, message.clone()))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+impl<E> Handler<E> for Scripted {
     fn init(&mut self, _: &mut E) -> Result<f64, Failure> {
-        Err(Failure::new(failure_code::SOLVER, self.0.clone()))
+        use interface_protocol::messages::command_kind::INIT;
+        self.answer(INIT, 0, None).map(|()| f64::INFINITY)
     }
     fn advance(&mut self, _: &mut E, c: &Command) -> Result<Progress, Failure> {
+        use interface_protocol::messages::scheme_phase::START;
+        self.answer(c.kind, c.scheme_phase, Some(c.step))?;
+        if c.scheme_phase != START {
+            self.steps = c.step + 1;
+        }
         Ok(Progress { step: c.step, t: c.t_to, dt_stable: f64::INFINITY })
     }
     fn checkpoint(&mut self, _: &mut E, _: &str) -> Result<(), Failure> {
-        Ok(())
+        use interface_protocol::messages::command_kind::CHECKPOINT;
+        self.answer(CHECKPOINT, 0, Some(self.steps))
     }
     fn finish(&mut self, _: &mut E) -> Result<(), Failure> {
-        Ok(())
+        use interface_protocol::messages::command_kind::FINISH;
+        self.answer(FINISH, 0, None)
     }
 }
 
-fn fail_init(
+fn scripted(
     role: Role,
     run_id: &str,
     info: HelloInfo,
     case: &Case,
-    message: &str,
+    mut handler: Scripted,
 ) -> anyhow::Result<()> {
     let timeouts = Timeouts::from_secs(case.coupling.timeout_s);
-    let mut handler = FailInit(message.to_string());
-    fn go<E: ControlPort>(mut ep: E, h: &mut FailInit) -> anyhow::Result<()> {
+    fn go<E: ControlPort>(mut ep: E, h: &mut Scripted) -> anyhow::Result<()> {
         serve(&mut ep, h).map_err(|e| anyhow::anyhow!("{e}"))
     }
     match role {
