@@ -7,7 +7,7 @@
 //! answers with a usage error (clap's exit code 2) offers no `check`: a warning, not a pass.
 
 use crate::scheme::{scheme_name, SchemeSettings, Sequencer};
-use crate::supervise::{describe_exit, participant_command, signal_group};
+use crate::supervise::{case_commands, describe_exit, participant_command, signal_group};
 use interface_protocol::case::Case;
 use interface_protocol::messages::Role;
 use std::fmt::Write;
@@ -45,13 +45,7 @@ pub fn check(case_file: &Path, overrides: &[String]) -> anyhow::Result<CheckRepo
     let case = Case::load(case_file, overrides)?;
     let s = SchemeSettings::of_case(&case);
     let seq = Sequencer::new(s).map_err(|e| anyhow::anyhow!("{}: {e}", case_file.display()))?;
-    let fluid =
-        case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
-    let structure = case
-        .structure
-        .as_ref()
-        .map(|s| s.command())
-        .unwrap_or_else(|| vec!["structure-solver".into()]);
+    let (fluid, structure) = case_commands(&case);
     let timeout = Duration::from_secs_f64(case.coupling.timeout_s);
     let asked = ask_participants(
         [(Role::Fluid, fluid.as_slice()), (Role::Structure, structure.as_slice())],

@@ -128,13 +128,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     let case = Case::load(&opts.case_file, &opts.overrides)?;
     let settings = SchemeSettings::of_case(&case);
     let mut seq = Sequencer::new(settings)?;
-    let fluid_cmd =
-        case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
-    let structure_cmd = case
-        .structure
-        .as_ref()
-        .map(|s| s.command())
-        .unwrap_or_else(|| vec!["structure-solver".into()]);
+    let (fluid_cmd, structure_cmd) = crate::supervise::case_commands(&case);
 
     let run_id = opts.run_id.clone().unwrap_or_else(new_run_id);
     interface_protocol::services::validate_run_id(&run_id)?;

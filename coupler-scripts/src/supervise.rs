@@ -6,6 +6,7 @@
 //! (`PR_SET_PDEATHSIG`). A child is stopped with SIGTERM (and SIGCONT, should it be stopped),
 //! then SIGKILL after [`KILL_GRACE`].
 
+use interface_protocol::case::Case;
 use interface_protocol::liveness::LAUNCHER_PID_ENV;
 use interface_protocol::messages::Role;
 use std::os::unix::process::{CommandExt, ExitStatusExt};
@@ -29,6 +30,19 @@ pub enum SpawnError {
 
 /// Where to look for a bare program name: the folder of the running `fsi`, then `PATH`.
 /// A name with a `/` is taken as given (relative to the current folder).
+/// The fluid's and the structure's commands of a case (`fluid-solver`, `structure-solver` when
+/// a section does not name one).
+pub fn case_commands(case: &Case) -> (Vec<String>, Vec<String>) {
+    let fluid =
+        case.fluid.as_ref().map(|f| f.command()).unwrap_or_else(|| vec!["fluid-solver".into()]);
+    let structure = case
+        .structure
+        .as_ref()
+        .map(|s| s.command())
+        .unwrap_or_else(|| vec!["structure-solver".into()]);
+    (fluid, structure)
+}
+
 pub fn resolve_program(name: &str, role: Role) -> Result<PathBuf, SpawnError> {
     if name.contains('/') {
         return Ok(PathBuf::from(name));

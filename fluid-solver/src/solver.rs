@@ -121,17 +121,18 @@ impl<'a> FluidRun<'a> {
         for w in &problem.warnings {
             eprintln!("fluid-solver: warning: {w}");
         }
-        let policy = match mode {
-            Mode::Alone => Policy::from_force(opts.force),
-            Mode::Coupled => Policy::Existing,
-        };
-        let out = OutputDir::create(&opts.out, policy)?;
         let Problem { semi, initial, stepping, t_end, max_steps, probes, placed, .. } = problem;
         let Placed { probe_nodes, mut lines } = placed;
+        // Read the checkpoint before the output folder is made: it may be the same folder.
         let (state, step, t) = match &opts.restart {
             Some(dir) => read_checkpoint(dir, semi.mesh.n_nodes())?,
             None => (initial, 0, 0.0),
         };
+        let policy = match mode {
+            Mode::Alone => Policy::alone(opts.force, opts.restart.as_deref(), &opts.out),
+            Mode::Coupled => Policy::Existing,
+        };
+        let out = OutputDir::create(&opts.out, policy)?;
         if opts.restart.is_some() {
             // Written before the checkpoint was taken.
             for line in &mut lines {

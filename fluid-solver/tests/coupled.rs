@@ -17,7 +17,7 @@ use fluid_solver::solver::{FluidRun, Mode, RunOptions};
 use interface_protocol::case::Case;
 use interface_protocol::endpoint::{LauncherLink, StructureEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
-use interface_protocol::io::checkpoint::Checkpoint;
+use interface_protocol::io::checkpoint::{tag_for_step, Checkpoint};
 use interface_protocol::liveness::LAUNCHER_PID_ENV;
 use interface_protocol::messages::{reply_kind, scheme_phase, Command, Reply, Role, StepHeader};
 use interface_protocol::participant::failure_code;
@@ -151,6 +151,37 @@ fn assert_same_rows(a: &Path, b: &Path) {
     }
 }
 
+/// `fluid-solver run --couple` on `case_path`, writing into `out`, with the launcher and a
+/// structure without a wet surface played here, after the handshake.
+fn start_coupled(
+    case_path: &Path,
+    case: &Case,
+    out: &Path,
+    tag: &str,
+) -> (LauncherLink, std::process::Child, StructureEndpoint) {
+    let id = run_id(tag);
+    let timeouts = Timeouts::from_secs(10.0);
+    let mut link = LauncherLink::open(&id, timeouts).unwrap();
+    let fluid = Process::new(bin("fluid-solver"))
+        .arg("run")
+        .arg(case_path)
+        .args(["--couple", &id, "--quiet", "--out"])
+        .arg(out)
+        .env(LAUNCHER_PID_ENV, std::process::id().to_string())
+        .stdin(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
+    let structure = StructureEndpoint::open(&id, info, timeouts).unwrap();
+    let soon = Instant::now() + Duration::from_secs(10);
+    let f = link.wait_hello(Role::Fluid, soon).unwrap();
+    let s = link.wait_hello(Role::Structure, soon).unwrap();
+    assert_eq!((f.n_surface_nodes, f.n_surface_elements), (0, 0), "the fluid accepts any count");
+    LauncherLink::check(&f, &s, case.hash()).unwrap();
+    (link, fluid, structure)
+}
+
 #[test]
 fn a_coupled_run_without_wet_surface_steps_like_the_fluid_alone() {
     let dir = tempfile::tempdir().unwrap();
@@ -158,28 +189,7 @@ fn a_coupled_run_without_wet_surface_steps_like_the_fluid_alone() {
     let case = Case::load(&case_path, &[]).unwrap();
     let coupled = dir.path().join("coupled");
     std::fs::create_dir(&coupled).unwrap();
-    let id = run_id("empty");
-    let timeouts = Timeouts::from_secs(10.0);
-
-    // The launcher and a structure without a wet surface, both played here.
-    let mut link = LauncherLink::open(&id, timeouts).unwrap();
-    let fluid = Process::new(bin("fluid-solver"))
-        .arg("run")
-        .arg(&case_path)
-        .args(["--couple", &id, "--quiet", "--out"])
-        .arg(&coupled)
-        .env(LAUNCHER_PID_ENV, std::process::id().to_string())
-        .stdin(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
-    let mut structure = StructureEndpoint::open(&id, info, timeouts).unwrap();
-    let soon = Instant::now() + Duration::from_secs(10);
-    let f = link.wait_hello(Role::Fluid, soon).unwrap();
-    let s = link.wait_hello(Role::Structure, soon).unwrap();
-    assert_eq!((f.n_surface_nodes, f.n_surface_elements), (0, 0), "the fluid accepts any count");
-    LauncherLink::check(&f, &s, case.hash()).unwrap();
+    let (mut link, fluid, mut structure) = start_coupled(&case_path, &case, &coupled, "empty");
 
     structure.publish_topology(header(0, 0.0), 0, |_| ()).unwrap();
     structure.publish_kinematics(header(0, 0.0), 0, |_| ()).unwrap();
@@ -196,7 +206,7 @@ fn a_coupled_run_without_wet_surface_steps_like_the_fluid_alone() {
         let (t, count) = structure.read_loads(|h, loads| (h.time, loads.len())).unwrap();
         assert_eq!((t, count), (w[1], 0), "the loads at t_to on no wet node");
         if n == 1 {
-            expect_reply(&mut link, &Command::checkpoint("step-2"), reply_kind::DONE);
+            expect_reply(&mut link, &Command::checkpoint(&tag_for_step(2)), reply_kind::DONE);
         }
     }
     // A command that does not start where the fluid stands is refused; the fluid carries on.
@@ -216,7 +226,7 @@ fn a_coupled_run_without_wet_surface_steps_like_the_fluid_alone() {
     link.remove_resources().unwrap();
 
     // The checkpoint the launcher asked for holds the fluid at t^2.
-    let ck = Checkpoint::read(&coupled.join("checkpoints"), "step-2", "fluid").unwrap();
+    let ck = Checkpoint::read(&coupled.join("checkpoints"), &tag_for_step(2), "fluid").unwrap();
     assert_eq!(ck.time, TIMES[2]);
     for f in ["fluid.h5", "fluid.xdmf", "probes.csv", "lines/axis.csv"] {
         assert!(coupled.join(f).is_file(), "{f} missing");
@@ -301,25 +311,7 @@ fn a_coupled_step_that_goes_bad_is_answered_failed_naming_node_and_field() {
     let case = Case::load(&case_path, &[]).unwrap();
     let coupled = dir.path().join("coupled");
     std::fs::create_dir(&coupled).unwrap();
-    let id = run_id("bad");
-    let timeouts = Timeouts::from_secs(10.0);
-    let mut link = LauncherLink::open(&id, timeouts).unwrap();
-    let fluid = Process::new(bin("fluid-solver"))
-        .arg("run")
-        .arg(&case_path)
-        .args(["--couple", &id, "--quiet", "--out"])
-        .arg(&coupled)
-        .env(LAUNCHER_PID_ENV, std::process::id().to_string())
-        .stdin(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
-    let mut structure = StructureEndpoint::open(&id, info, timeouts).unwrap();
-    let soon = Instant::now() + Duration::from_secs(10);
-    let f = link.wait_hello(Role::Fluid, soon).unwrap();
-    let s = link.wait_hello(Role::Structure, soon).unwrap();
-    LauncherLink::check(&f, &s, case.hash()).unwrap();
+    let (mut link, fluid, mut structure) = start_coupled(&case_path, &case, &coupled, "bad");
     structure.publish_topology(header(0, 0.0), 0, |_| ()).unwrap();
     structure.publish_kinematics(header(0, 0.0), 0, |_| ()).unwrap();
     expect_reply(&mut link, &Command::init(), reply_kind::READY);

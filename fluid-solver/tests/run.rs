@@ -28,14 +28,19 @@ fn run_case(
     overrides: &[String],
     restart: Option<PathBuf>,
 ) -> anyhow::Result<solver::RunSummary> {
+    run_case_forced(out, overrides, restart, false)
+}
+
+fn run_case_forced(
+    out: &Path,
+    overrides: &[String],
+    restart: Option<PathBuf>,
+    force: bool,
+) -> anyhow::Result<solver::RunSummary> {
     let path = case_path();
     let case = Case::load(&path, overrides)?;
     let text = std::fs::read_to_string(&path)?;
-    solver::run(
-        &case,
-        &text,
-        &RunOptions { out: out.to_path_buf(), quiet: true, restart, force: false },
-    )
+    solver::run(&case, &text, &RunOptions { out: out.to_path_buf(), quiet: true, restart, force })
 }
 
 #[test]
@@ -107,6 +112,24 @@ fn restarted_run_is_bitwise_identical() {
         .iter()
         .zip(&sc.cons)
         .all(|(x, y)| x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())));
+}
+
+/// A restart into its own folder is refused without `--force` (nothing touched) and, with it,
+/// reads its checkpoint before the folder is reused, so it continues to the same end state.
+#[test]
+fn a_restart_into_its_own_folder_needs_force_and_keeps_its_checkpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = dir.path().join("full");
+    let run = dir.path().join("run");
+    let a = run_case(&full, &small(&[]), None).unwrap();
+    run_case(&run, &small(&["fluid.time.max_steps=7"]), None).unwrap();
+    let e = run_case(&run, &small(&[]), Some(run.clone())).unwrap_err().to_string();
+    assert!(e.contains("--force"), "{e}");
+    let c = run_case_forced(&run, &small(&[]), Some(run.clone()), true).unwrap();
+    assert_eq!((a.steps, a.time.to_bits()), (c.steps, c.time.to_bits()));
+    let (sa, _, _) = read_checkpoint(&full, a.nodes).unwrap();
+    let (sc, _, _) = read_checkpoint(&run, c.nodes).unwrap();
+    assert!(sa.cons == sc.cons, "the continued run ends where the uninterrupted one does");
 }
 
 #[test]

@@ -196,7 +196,7 @@ mod tests {
 
     #[test]
     fn commands_and_replies_round_trip() {
-        assert_eq!(Command::checkpoint("step-10").tag_str(), "step-10");
+        assert_eq!(Command::checkpoint("step_0000000010").tag_str(), "step_0000000010");
         assert_eq!(
             Command::advance(3, 0.5, 0.75, scheme_phase::PREDICT).describe(),
             "Advance PREDICT step 3 [0.5, 0.75]"

@@ -159,13 +159,9 @@ struct Reached {
 }
 
 /// The folders `a` and `b` are one (both exist and resolve to the same path).
-fn same_folder(a: &Path, b: &Path) -> bool {
-    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
-}
-
 /// Runs a case alone. The output folder follows the one rule of every binary: a folder that
-/// holds a run is refused unless `--force`; a restart from the same folder continues that run
-/// in place (its checkpoints stay). Every step is checked finite before anything is written;
+/// holds a run is refused unless `--force`; a restart from the same folder under `--force`
+/// continues that run in place (its checkpoints stay, [`Policy::alone`]). Every step is checked finite before anything is written;
 /// `run.json` records how the run ended, failed runs included.
 pub fn run(opts: &RunOptions) -> anyhow::Result<RunSummary> {
     let case = Case::load(&opts.case, &opts.set)?;
@@ -186,10 +182,7 @@ pub fn run(opts: &RunOptions) -> anyhow::Result<RunSummary> {
         Some(from) => Some(read_checkpoint(from, &mut model)?),
         None => None,
     };
-    let policy = match &opts.restart {
-        Some(from) if same_folder(from, &out) => Policy::Existing,
-        _ => Policy::from_force(opts.force),
-    };
+    let policy = Policy::alone(opts.force, opts.restart.as_deref(), &out);
     let dir = OutputDir::create(&out, policy)?;
     let names: Vec<&str> = s.probes.iter().map(|p| p.name.as_str()).collect();
     let started = Instant::now();

@@ -2,7 +2,7 @@
 //! `cases/structure-cantilever-plate`: a step far above the stable one stops at the first
 //! non-finite state naming step, node and dof and saying the step is unstable, with `run.json`
 //! failed and the newest checkpoint from before the blow-up (it restarts); an output folder that
-//! holds a run is refused without `--force`, a restart continues in its own folder and says
+//! holds a run is refused without `--force`, a restart continues in its own folder under `--force` and says
 //! which checkpoint it used when the newest is damaged; step
 //! counts past `MAX_STEPS` are refused naming the keys; `check` validates alone and coupled
 //! cases without writing anything.
@@ -99,10 +99,14 @@ fn a_folder_holding_a_run_is_refused_without_force() {
     let forced: Vec<&str> = short.iter().copied().chain(["--force"]).collect();
     let o = run(&out, &forced);
     assert!(o.status.success(), "{}", stderr(&o));
-    // a restart continues in the run's own folder, its checkpoints kept
+    // a restart into the run's own folder is refused without --force, and continues there
+    // with it, its checkpoints kept
     let newest = checkpoint::latest(&out.join("checkpoints"), &["structure"]).unwrap().unwrap();
     let longer = ["--set", "structure.t_end=4e-4", "--restart", out.to_str().unwrap()];
-    let longer: Vec<&str> = longer.iter().copied().chain(short[2..].iter().copied()).collect();
+    let mut longer: Vec<&str> = longer.iter().copied().chain(short[2..].iter().copied()).collect();
+    let o = run(&out, &longer);
+    assert!(!o.status.success() && stderr(&o).contains("--force"), "{}", stderr(&o));
+    longer.push("--force");
     let o = run(&out, &longer);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(out.join("checkpoints").join(&newest.tag).is_dir());

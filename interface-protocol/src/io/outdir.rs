@@ -36,6 +36,18 @@ pub enum Policy {
 }
 
 impl Policy {
+    /// The rule of a run alone, [`Policy::from_force`], with one refinement: a restart from
+    /// the output folder itself under `--force` continues that run in place (`Existing`: its
+    /// checkpoints stay, its other outputs are written anew from the restart time), and without
+    /// `--force` is refused like any folder holding a run. Read the checkpoint first.
+    pub fn alone(force: bool, restart_from: Option<&Path>, out: &Path) -> Self {
+        let same = |from: &Path| matches!((from.canonicalize(), out.canonicalize()), (Ok(a), Ok(b)) if a == b);
+        match restart_from {
+            Some(from) if force && same(from) => Policy::Existing,
+            _ => Policy::from_force(force),
+        }
+    }
+
     /// `Overwrite` when the user passed `--force`, `Fresh` otherwise.
     pub fn from_force(force: bool) -> Self {
         if force {

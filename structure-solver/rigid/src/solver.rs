@@ -286,6 +286,13 @@ fn solver_in(case: &interface_protocol::case::Case, dir: &std::path::Path) -> Ri
     RigidSolver::new(Setup::new(case).unwrap(), out).unwrap()
 }
 
+/// The rows of `structure_probes.csv` in `dir`, header skipped (tests).
+#[cfg(test)]
+fn probe_rows(dir: &std::path::Path) -> Vec<Vec<f64>> {
+    let csv = std::fs::read_to_string(dir.join("structure_probes.csv")).unwrap();
+    csv.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -376,12 +383,7 @@ mod failure_tests {
         // It stopped long before t_end, and no probe row holds a NaN or an infinity.
         assert!(s.t < 20.0, "t = {}", s.t);
         drop(s);
-        let csv = std::fs::read_to_string(dir.path().join("structure_probes.csv")).unwrap();
-        let rows: Vec<Vec<f64>> = csv
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect();
+        let rows = probe_rows(dir.path());
         assert!(rows.len() > 10, "{} rows", rows.len());
         assert!(rows.iter().flatten().all(|x| x.is_finite()), "a non-finite probe row");
         // The stable step converges, and A6 is unconditionally stable.
@@ -514,12 +516,7 @@ mod coupled_tests {
         structure.join().unwrap();
         fluid.join().unwrap();
         link.remove_resources().unwrap();
-        let csv = std::fs::read_to_string(dir.path().join("structure_probes.csv")).unwrap();
-        let rows: Vec<Vec<f64>> = csv
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect();
+        let rows = probe_rows(dir.path());
         assert_eq!(rows.len() as u64, n + 1);
         rows.iter().map(|r| (r[1] - exact(r[0])).abs()).fold(0.0, f64::max)
     }
