@@ -131,7 +131,9 @@ impl Command {
                     scheme_phase::CORRECT => "CORRECT",
                     _ => "?",
                 };
-                format!("Advance {phase} step {} [{}, {}]", self.step, self.t_from, self.t_to)
+                // Times to 12 significant digits: step 360 of 0.03 reads 10.8, not 10.799999999999999.
+                let t = |v: f64| format!("{v:.11e}").parse().unwrap_or(v);
+                format!("Advance {phase} step {} [{}, {}]", self.step, t(self.t_from), t(self.t_to))
             }
             command_kind::CHECKPOINT => format!("Checkpoint {}", self.tag_str()),
             command_kind::FINISH => "Finish".into(),
@@ -200,6 +202,10 @@ mod tests {
         assert_eq!(
             Command::advance(3, 0.5, 0.75, scheme_phase::PREDICT).describe(),
             "Advance PREDICT step 3 [0.5, 0.75]"
+        );
+        assert_eq!(
+            Command::advance(360, 360.0 * 0.03, 10.83, scheme_phase::CORRECT).describe(),
+            "Advance CORRECT step 360 [10.8, 10.83]"
         );
         let r = Reply::failed(0, "boom");
         assert_eq!((r.kind, r.code, r.message_str().as_str()), (reply_kind::FAILED, 1, "boom"));
