@@ -146,15 +146,7 @@ impl Mesh {
 
     /// The corners `(lo, hi)` of the axis-aligned box around the nodes.
     pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &self.coords {
-            for d in 0..3 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        (lo, hi)
+        bounding_box(&self.coords)
     }
 
     /// Shortest edge length at each node.
@@ -187,18 +179,24 @@ impl Mesh {
     }
 }
 
-/// Moves each node by a random vector of length up to `fraction` times its shortest edge,
-/// keeping nodes on the planes `x, y, z = min/max` of the bounding box on them (for making
-/// "unstructured" test meshes from box meshes). Deterministic for a seed.
-pub fn perturb(raw: &mut RawMesh, fraction: f64, seed: u64) {
+/// The corners `(lo, hi)` of the axis-aligned box around `points`.
+fn bounding_box(points: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for p in &raw.coords {
+    for p in points {
         for d in 0..3 {
             lo[d] = lo[d].min(p[d]);
             hi[d] = hi[d].max(p[d]);
         }
     }
+    (lo, hi)
+}
+
+/// Moves each node by a random vector of length up to `fraction` times its shortest edge,
+/// keeping nodes on the planes `x, y, z = min/max` of the bounding box on them (for making
+/// "unstructured" test meshes from box meshes). Deterministic for a seed.
+pub fn perturb(raw: &mut RawMesh, fraction: f64, seed: u64) {
+    let (lo, hi) = bounding_box(&raw.coords);
     let mut h = vec![f64::INFINITY; raw.coords.len()];
     for c in &raw.cells {
         for &[a, b] in c.kind.edges() {
