@@ -67,10 +67,14 @@ fn check_wave(
         assert_eq!(speed.0, speed.1);
         let m_k = k.rho * (k.u - s);
         let m_s = rho_star * (u_star - s);
-        assert!(close(m_s, m_k, rel), "mass {m_k} vs {m_s}");
+        // The fluxes are differences of terms of size ρ(|u| + |s|): a weak flux through a fast
+        // shock (a near-vacuum state hit by a strong one) is exact only to round-off of those.
+        let scale = k.rho * (k.u.abs() + s.abs());
+        assert!((m_s - m_k).abs() <= rel * scale.max(m_k.abs()), "mass {m_k} vs {m_s}");
         let mom_k = m_k * (k.u - s) + k.p;
         let mom_s = m_s * (u_star - s) + p_star;
-        assert!(close(mom_s, mom_k, rel), "momentum {mom_k} vs {mom_s}");
+        let mom_scale = scale * (k.u.abs() + s.abs()) + k.p;
+        assert!((mom_s - mom_k).abs() <= rel * mom_scale, "momentum {mom_k} vs {mom_s}");
         if eos.is_barotropic() {
             assert!(close(eos.tait_pressure(rho_star), p_star, rel));
         } else {
