@@ -14,6 +14,7 @@ pub mod bc;
 pub mod bench;
 pub mod check;
 pub mod couple;
+pub mod embedded;
 pub mod eos;
 pub mod flux;
 pub mod initial;

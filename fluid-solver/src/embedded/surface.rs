@@ -1,0 +1,214 @@
+//! The embedded surface as the fluid holds it (DESIGN §5.1): triangles (quads split in two, with
+//! the map back to the structure's elements), the crack level set `phi` at the corners of each
+//! triangle (thesis §4.3), and the nodal positions and velocities at both ends of the step.
+//!
+//! Inside a step `[t_a, t_b]` the surface moves on the cubic Hermite path between `(x_a, v_a)` and
+//! `(x_b, v_b)` (DESIGN §4): the wall velocity at any stage time is the exact time derivative of
+//! the wall position, so a rigid translation moves no mass through the surface.
+
+use interface_protocol::messages::SurfaceElement;
+
+/// The surface of one step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Surface {
+    /// Node triples into the nodal arrays; quads `(a, b, c, d)` become `(a, b, c)` and `(a, c, d)`.
+    pub triangles: Vec<[u32; 3]>,
+    /// For each triangle, the structure element (index into the topology message) it comes from.
+    pub element_of: Vec<u32>,
+    /// Crack level set at the three corners of each triangle; an intersection counts only where the
+    /// interpolated value is `>= 0`. Uncracked elements carry `1.0`.
+    pub phi: Vec<[f64; 3]>,
+    /// Topology version the triangles were built from.
+    pub topology_version: u64,
+    /// Start and end of the step.
+    pub t_a: f64,
+    pub t_b: f64,
+    /// Nodal positions and velocities at `t_a` and at `t_b`.
+    pub x_a: Vec<[f64; 3]>,
+    pub v_a: Vec<[f64; 3]>,
+    pub x_b: Vec<[f64; 3]>,
+    pub v_b: Vec<[f64; 3]>,
+}
+
+/// A surface input that cannot be used, named.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SurfaceError {
+    #[error("surface element {element} has {n} nodes; triangles (3) and quads (4) are accepted")]
+    NodeCount { element: usize, n: u8 },
+    #[error(
+        "surface element {element} refers to node {node}, but the surface has {n_nodes} nodes"
+    )]
+    BadNode { element: usize, node: u32, n_nodes: usize },
+    #[error("surface element {element} has a non-finite phi {phi:?}")]
+    BadPhi { element: usize, phi: [f64; 4] },
+}
+
+impl Surface {
+    /// A surface at rest at `x` (positions at both ends equal, velocities zero) from elements, for
+    /// a topology `version`; `set_motion` then gives it its motion over a step.
+    pub fn new(
+        elements: &[SurfaceElement],
+        x: Vec<[f64; 3]>,
+        version: u64,
+    ) -> Result<Surface, SurfaceError> {
+        let n_nodes = x.len();
+        let mut triangles = Vec::with_capacity(elements.len() * 2);
+        let mut element_of = Vec::with_capacity(elements.len() * 2);
+        let mut phi = Vec::with_capacity(elements.len() * 2);
+        for (k, e) in elements.iter().enumerate() {
+            let n = e.n_nodes as usize;
+            if n != 3 && n != 4 {
+                return Err(SurfaceError::NodeCount { element: k, n: e.n_nodes });
+            }
+            if let Some(&node) = e.nodes[..n].iter().find(|&&v| v as usize >= n_nodes) {
+                return Err(SurfaceError::BadNode { element: k, node, n_nodes });
+            }
+            if e.phi[..n].iter().any(|p| !p.is_finite()) {
+                return Err(SurfaceError::BadPhi { element: k, phi: e.phi });
+            }
+            let corners: &[[usize; 3]] =
+                if n == 3 { &[[0, 1, 2]] } else { &[[0, 1, 2], [0, 2, 3]] };
+            for c in corners {
+                triangles.push(c.map(|m| e.nodes[m]));
+                element_of.push(k as u32);
+                phi.push(c.map(|m| e.phi[m]));
+            }
+        }
+        let zero = vec![[0.0; 3]; n_nodes];
+        Ok(Surface {
+            triangles,
+            element_of,
+            phi,
+            topology_version: version,
+            t_a: 0.0,
+            t_b: 0.0,
+            x_a: x.clone(),
+            v_a: zero.clone(),
+            x_b: x,
+            v_b: zero,
+        })
+    }
+
+    /// Number of surface nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.x_a.len()
+    }
+
+    /// Starts a new step `[t_a, t_b]`: the old end state becomes the start state, and
+    /// `(x_b, v_b)` the new end state.
+    pub fn advance(&mut self, t_b: f64, x_b: &[[f64; 3]], v_b: &[[f64; 3]]) {
+        std::mem::swap(&mut self.x_a, &mut self.x_b);
+        std::mem::swap(&mut self.v_a, &mut self.v_b);
+        self.x_b.copy_from_slice(x_b);
+        self.v_b.copy_from_slice(v_b);
+        self.t_a = self.t_b;
+        self.t_b = t_b;
+    }
+
+    /// Position and velocity of node `n` at time `t` on the cubic Hermite path (DESIGN §4); at
+    /// `t_a` and `t_b` exactly the end states. A step of zero length returns the end state.
+    #[inline]
+    pub fn node_at(&self, n: usize, t: f64) -> ([f64; 3], [f64; 3]) {
+        let h = self.t_b - self.t_a;
+        if h <= 0.0 {
+            return (self.x_b[n], self.v_b[n]);
+        }
+        let s = ((t - self.t_a) / h).clamp(0.0, 1.0);
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10, h01, h11) =
+            (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s, 3.0 * s2 - 2.0 * s3, s3 - s2);
+        let (d00, d10, d01, d11) =
+            (6.0 * (s2 - s), 3.0 * s2 - 4.0 * s + 1.0, 6.0 * (s - s2), 3.0 * s2 - 2.0 * s);
+        let (xa, va, xb, vb) = (self.x_a[n], self.v_a[n], self.x_b[n], self.v_b[n]);
+        let mut x = [0.0; 3];
+        let mut v = [0.0; 3];
+        for k in 0..3 {
+            x[k] = h00 * xa[k] + h10 * h * va[k] + h01 * xb[k] + h11 * h * vb[k];
+            v[k] = (d00 * xa[k] + d01 * xb[k]) / h + d10 * va[k] + d11 * vb[k];
+        }
+        (x, v)
+    }
+
+    /// Corners and corner velocities of triangle `tri` at time `t`.
+    #[inline]
+    pub fn triangle_at(&self, tri: usize, t: f64) -> ([[f64; 3]; 3], [[f64; 3]; 3]) {
+        let c = self.triangles[tri];
+        let p = c.map(|n| self.node_at(n as usize, t));
+        (p.map(|q| q.0), p.map(|q| q.1))
+    }
+
+    /// Position and velocity of the point with barycentric coordinates `bary` in triangle `tri` at
+    /// time `t` (the wall velocity the fluid-structure Riemann problem of Alg. 5.1 sees).
+    #[inline]
+    pub fn point_at(&self, tri: usize, bary: [f64; 3], t: f64) -> ([f64; 3], [f64; 3]) {
+        let (x, v) = self.triangle_at(tri, t);
+        let mut px = [0.0; 3];
+        let mut pv = [0.0; 3];
+        for m in 0..3 {
+            for k in 0..3 {
+                px[k] += bary[m] * x[m][k];
+                pv[k] += bary[m] * v[m][k];
+            }
+        }
+        (px, pv)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> Surface {
+        let e = SurfaceElement { nodes: [0, 1, 2, 3], n_nodes: 4, ..Default::default() };
+        let x = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        Surface::new(&[e], x, 1).unwrap()
+    }
+
+    #[test]
+    fn quads_split_into_two_triangles_with_the_map_back() {
+        let s = quad();
+        assert_eq!(s.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(s.element_of, vec![0, 0]);
+    }
+
+    #[test]
+    fn bad_elements_are_named() {
+        let e = SurfaceElement { nodes: [0, 1, 9, 0], n_nodes: 3, ..Default::default() };
+        let err = Surface::new(&[e], vec![[0.0; 3]; 3], 0).unwrap_err();
+        assert_eq!(err, SurfaceError::BadNode { element: 0, node: 9, n_nodes: 3 });
+        let e = SurfaceElement { n_nodes: 5, ..Default::default() };
+        assert!(matches!(
+            Surface::new(&[e], vec![[0.0; 3]; 3], 0),
+            Err(SurfaceError::NodeCount { .. })
+        ));
+    }
+
+    /// The Hermite path reproduces any cubic motion exactly, and its velocity is the exact
+    /// derivative of its position (checked by a central difference).
+    #[test]
+    fn hermite_path_is_exact_for_cubics_and_consistent() {
+        let mut s = quad();
+        let x = |t: f64| [1.0 + 2.0 * t - t * t * t, 0.5 * t * t, 3.0];
+        let v = |t: f64| [2.0 - 3.0 * t * t, t, 0.0];
+        let (ta, tb) = (0.3, 0.8);
+        s.t_b = ta;
+        let xa = vec![x(ta); 4];
+        let va = vec![v(ta); 4];
+        s.advance(ta, &xa, &va);
+        s.advance(tb, &vec![x(tb); 4], &vec![v(tb); 4]);
+        assert_eq!((s.t_a, s.t_b), (ta, tb));
+        for k in 0..=10 {
+            let t = ta + (tb - ta) * k as f64 / 10.0;
+            let (px, pv) = s.node_at(2, t);
+            for c in 0..3 {
+                assert!((px[c] - x(t)[c]).abs() < 1e-14, "x at {t}");
+                assert!((pv[c] - v(t)[c]).abs() < 1e-13, "v at {t}");
+            }
+        }
+        let (t, h) = (0.55, 1e-6);
+        let d = (s.node_at(0, t + h).0[0] - s.node_at(0, t - h).0[0]) / (2.0 * h);
+        assert!((d - s.node_at(0, t).1[0]).abs() < 1e-8);
+        let (p, w) = s.point_at(1, [0.2, 0.3, 0.5], tb);
+        assert!((p[0] - x(tb)[0]).abs() < 1e-14 && (w[0] - v(tb)[0]).abs() < 1e-13);
+    }
+}
