@@ -192,10 +192,10 @@ mod tests {
         let v = |t: f64| [2.0 - 3.0 * t * t, t, 0.0];
         let (ta, tb) = (0.3, 0.8);
         s.t_b = ta;
-        let xa = vec![x(ta); 4];
-        let va = vec![v(ta); 4];
+        let xa = [x(ta); 4];
+        let va = [v(ta); 4];
         s.advance(ta, &xa, &va);
-        s.advance(tb, &vec![x(tb); 4], &vec![v(tb); 4]);
+        s.advance(tb, &[x(tb); 4], &[v(tb); 4]);
         assert_eq!((s.t_a, s.t_b), (ta, tb));
         for k in 0..=10 {
             let t = ta + (tb - ta) * k as f64 / 10.0;
