@@ -73,6 +73,9 @@ pub struct FluidSection {
     /// `[[fluid.lines]]`: straight lines sampled into `lines/<name>.csv` at given times.
     #[serde(default)]
     pub lines: Vec<FluidLine>,
+    /// `[fluid.embedded]`: an embedded surface with a prescribed motion (fluid-alone runs).
+    #[serde(default)]
+    pub embedded: Option<super::FluidEmbedded>,
 }
 
 /// `[fluid.mesh]`: a box mesh or a gmsh file (exactly one).
@@ -431,6 +434,9 @@ impl FluidSection {
                     format!("expected a finite time >= 0, got {t}"),
                 ));
             }
+        }
+        if let Some(e) = &self.embedded {
+            e.validate()?;
         }
         let mut names: Vec<&str> = self.probes.iter().map(|p| p.name.as_str()).collect();
         names.sort_unstable();

@@ -10,6 +10,7 @@
 //! with different overrides refuse to couple.
 
 mod coupling;
+mod embedded;
 mod fluid;
 mod locate;
 mod output;
@@ -18,6 +19,7 @@ mod rigid;
 mod structure;
 
 pub use coupling::*;
+pub use embedded::*;
 pub use fluid::*;
 pub use output::*;
 pub use piston::*;
