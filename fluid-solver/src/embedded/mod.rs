@@ -8,6 +8,7 @@
 //! at every cut edge) -> `loads` (Alg. 5.3 and 5.4). The residual sees all of it through a
 //! read-only view with the stage time; `Semidiscretization` never owns the surface.
 
+pub mod generate;
 pub mod surface;
 
 pub use surface::Surface;
