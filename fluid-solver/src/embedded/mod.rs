@@ -9,6 +9,7 @@
 //! read-only view with the stage time; `Semidiscretization` never owns the surface.
 
 pub mod generate;
+pub mod motion;
 pub mod surface;
 
 pub use surface::Surface;
