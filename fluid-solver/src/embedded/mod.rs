@@ -10,6 +10,7 @@
 
 pub mod generate;
 pub mod motion;
+pub mod read;
 pub mod surface;
 
 pub use surface::Surface;
