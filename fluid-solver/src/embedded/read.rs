@@ -38,7 +38,7 @@ fn from_msh(msh: &gmsh::Msh) -> Result<SurfaceMesh, GmshError> {
             let p: Vec<[f64; 3]> = ids.iter().map(|&i| msh.coords[i as usize]).collect();
             let area = polygon_area(&p);
             let size = p.iter().map(|q| dist(*q, p[0])).fold(0.0, f64::max);
-            if !(area > 1e-12 * size * size) {
+            if area.is_nan() || area <= 1e-12 * size * size {
                 return Err(msh.error(
                     at,
                     format!(
