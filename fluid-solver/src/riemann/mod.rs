@@ -9,6 +9,7 @@
 
 mod fluid_structure;
 mod sample;
+pub mod simple_wave;
 mod wave_curve;
 
 pub use fluid_structure::{fluid_structure, WallState};
