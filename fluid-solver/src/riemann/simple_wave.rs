@@ -99,7 +99,7 @@ mod tests {
         let wave = SimpleWave { piston, gamma: 1.4, rho0: 1.3, p0: 1e5 };
         let residual = |x: f64, t: f64, h: f64| {
             let s = |x: f64, t: f64| wave.state(x, t).unwrap();
-            let ((rp, up, pp), (rm, um, pm)) = (s(x, t + h / 400.0), s(x, t - h / 400.0));
+            let ((rp, up, _), (rm, um, _)) = (s(x, t + h / 400.0), s(x, t - h / 400.0));
             let ((rr, ur, pr), (rl, ul, pl)) = (s(x + h, t), s(x - h, t));
             let (dt, dx) = (2.0 * h / 400.0, 2.0 * h);
             let mass = (rp - rm) / dt + (rr * ur - rl * ul) / dx;
