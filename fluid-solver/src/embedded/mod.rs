@@ -8,7 +8,14 @@
 //! at every cut edge) -> `loads` (Alg. 5.3 and 5.4). The residual sees all of it through a
 //! read-only view with the stage time; `Semidiscretization` never owns the surface.
 
+pub mod adjacency;
+pub mod bvh;
+pub mod intersect;
+pub mod predicates;
+pub mod status;
 pub mod surface;
+#[cfg(test)]
+mod tests;
 
 pub use surface::Surface;
 
