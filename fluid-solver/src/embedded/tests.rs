@@ -360,6 +360,51 @@ fn swept_nodes_of_a_translated_plane_change_side() {
     assert_eq!(fresh.side, sides1.side);
 }
 
+/// A sphere moving through the mesh, a fraction of a cell per step: after each step the sides
+/// updated from the swept nodes give every node the status a brute-force inside test gives, the
+/// same as a fresh flood fill; only swept or occluded nodes change.
+#[test]
+fn a_moving_sphere_keeps_statuses_right_through_swept_nodes() {
+    let mesh = cube_mesh(12, 0.3, 21);
+    let adj = NodeEdges::build(&mesh);
+    let mut s = sphere([0.4, 0.5, 0.48], 0.27, 8);
+    let rest = s.x_b.clone();
+    let mut bvh = Bvh::build(&s, PAD);
+    let seeds =
+        [Seed { point: [0.0; 3], fluid: true }, Seed { point: [0.4, 0.5, 0.48], fluid: false }];
+    let mut sides = flood_fill(&mesh, &adj, &collision(&mesh, &adj, at(&s, &bvh)), &seeds).unwrap();
+    let mut changed = 0;
+    for step in 1..=4 {
+        let (shift, t) = (0.05 * step as f64, 0.01 * step as f64);
+        let x: Vec<[f64; 3]> =
+            rest.iter().map(|p| [p[0] + shift, p[1], p[2] + 0.3 * shift]).collect();
+        s.advance(t, &x, &vec![[5.0, 0.0, 1.5]; x.len()]);
+        bvh.refit(&s).unwrap();
+        let cuts = collision(&mesh, &adj, at(&s, &bvh));
+        let swept = swept_nodes(&mesh, &s, &bvh);
+        let (new, changes) = update_sides(&mesh, &adj, &sides, &cuts, &swept);
+        for c in &changes {
+            let i = c.node as usize;
+            assert!(
+                swept.binary_search(&c.node).is_ok()
+                    || cuts.occluded[i]
+                    || sides.status[i] == NodeStatus::Occluded
+            );
+        }
+        let fresh = flood_fill(&mesh, &adj, &cuts, &seeds).unwrap();
+        assert_eq!(new.status, fresh.status, "step {step}");
+        for i in 0..mesh.n_nodes() {
+            if new.status[i] != NodeStatus::Occluded {
+                let active = new.status[i] == NodeStatus::Active;
+                assert_eq!(active, !inside_by_winding(&s, mesh.coords[i]), "step {step}, node {i}");
+            }
+        }
+        changed += changes.len();
+        sides = new;
+    }
+    assert!(changed > 40, "{changed} nodes changed side");
+}
+
 /// §4.4: on a uniform tet grid the shortest edge a horizontal plane cuts is a vertical one,
 /// of length h, so a move of 0.09 over h = 0.125 gives 0.72.
 #[test]
