@@ -121,6 +121,19 @@ impl Bvh {
         bvh
     }
 
+    /// Makes the tree fit `surface`: rebuilt when its topology version or triangle count
+    /// changed, refitted otherwise.
+    pub fn update(&mut self, surface: &Surface) {
+        if surface.topology_version != self.topology_version
+            || surface.triangles.len() != self.tri_lo.len()
+        {
+            *self = Bvh::build(surface, self.pad);
+        } else {
+            self.triangle_boxes(&surface.triangles, &[&surface.x_a, &surface.x_b]);
+            self.fit_nodes();
+        }
+    }
+
     /// Refits the boxes to the surface's new positions (`x_a`, `x_b`) without changing the tree.
     /// A surface of another size needs [`Bvh::build`].
     pub fn refit(&mut self, surface: &Surface) -> Result<(), BvhError> {
@@ -351,8 +364,12 @@ mod tests {
         let mut bvh = Bvh::build(&s, 0.0);
         bvh.nodes[1].hi[0] += 10.0;
         assert_eq!(bvh.validate(), Err(BvhError::ChildOutside { node: 0, child: 1 }));
-        let other = sphere([0.0; 3], 1.0, 2);
+        let mut other = sphere([0.0; 3], 1.0, 2);
         assert!(matches!(bvh.refit(&other), Err(BvhError::Topology { .. })));
+        other.topology_version = 2;
+        bvh.update(&other);
+        assert_eq!((bvh.len(), bvh.topology_version), (other.triangles.len(), 2));
+        bvh.validate().unwrap();
         let empty = Surface::new(&[], vec![], 0).unwrap();
         let bvh = Bvh::build(&empty, 0.0);
         bvh.validate().unwrap();

@@ -145,8 +145,10 @@ impl SurfaceAt<'_> {
             .into_par_iter()
             .map(|i| {
                 let r = OCCLUSION * h_min[i];
-                self.nearest_point(mesh.coords[i], r, crack_aware)
-                    .is_some_and(|(_, c)| c.dist2 <= r * r)
+                r.is_finite()
+                    && self
+                        .nearest_point(mesh.coords[i], r, crack_aware)
+                        .is_some_and(|(_, c)| c.dist2 <= r * r)
             })
             .collect()
     }

@@ -21,7 +21,7 @@
 
 use super::{Intersections, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
-use crate::embedded::predicates::{unit_normal, Feature};
+use crate::embedded::predicates::{closest_point, unit_normal, Closest, Feature};
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
@@ -70,15 +70,21 @@ pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) 
         .map(|i| {
             let p = mesh.coords[i];
             let (lo, hi) = adjacency.node_box(mesh, i);
-            let mut first: Option<f64> = None;
+            let mut best: Option<(u32, Closest)> = None;
             at.bvh.for_each_overlap(&lo, &hi, |t| {
                 let [a, b, c] = at.corners(t);
-                let d2 = crate::embedded::predicates::closest_point(p, a, b, c).dist2;
-                first = Some(first.map_or(d2, |f| f.min(d2)));
+                let cp = closest_point(p, a, b, c);
+                if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
+                    best = Some((t, cp));
+                }
             });
-            // The nearest triangle is within that distance, whether or not its box met b_i.
-            let r = first?.sqrt();
-            let (t, cp) = at.nearest_point(p, r * (1.0 + 1e-12) + f64::MIN_POSITIVE, false)?;
+            let (mut t, mut cp) = best?;
+            // The nearest triangle lies within that distance; unless the ball of that radius is
+            // inside b_i, look for it beyond b_i.
+            let r = cp.dist2.sqrt();
+            if (0..3).any(|d| p[d] - r < lo[d] || p[d] + r > hi[d]) {
+                (t, cp) = at.nearest_point(p, r * (1.0 + 1e-12) + f64::MIN_POSITIVE, false)?;
+            }
             let [a, b, c] = at.corners(t);
             let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
             Some(dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0)
