@@ -86,6 +86,7 @@ pub fn flood_fill(
         return Err(StatusError::NoSeed);
     }
     let n = mesh.n_nodes();
+    debug_assert_eq!(cuts.occluded.len(), n, "intersections of another mesh");
     let cut = cuts.cut_mask(mesh.n_edges());
     let mut side = vec![NO_SIDE; n];
     let mut queue = Vec::new();
@@ -175,6 +176,7 @@ pub fn update_sides(
     swept: &[u32],
 ) -> (NodeSides, Vec<SideChange>) {
     let n = mesh.n_nodes();
+    debug_assert!(old.side.len() == n && cuts.occluded.len() == n, "sides of another mesh");
     let cut = cuts.cut_mask(mesh.n_edges());
     let mut side = old.side.clone();
     for &i in swept {

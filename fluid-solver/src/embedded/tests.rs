@@ -115,7 +115,7 @@ use super::status::{flood_fill, step_ratio, swept_nodes, update_sides, NodeStatu
 const PAD: f64 = 1e-12;
 
 fn at<'a>(s: &'a Surface, bvh: &'a Bvh) -> SurfaceAt<'a> {
-    SurfaceAt { surface: s, x: &s.x_b, bvh }
+    SurfaceAt::at_end(s, bvh).unwrap()
 }
 
 /// The cut list is sorted, one record per edge, and each block's records are its own edges.
@@ -420,9 +420,10 @@ fn step_ratio_compares_the_move_with_the_cut_edges() {
     assert!((r - 0.09 / 0.125).abs() < 1e-12, "{r}");
 }
 
-/// Seeds that contradict each other or sit on the surface are named.
+/// Seeds that contradict each other or sit on the surface are named, as are mismatched views.
 #[test]
 fn bad_seeds_are_named() {
+    use super::intersect::SurfaceAtError;
     use super::status::StatusError;
     let mesh = cube_mesh(6, 0.0, 0);
     let adj = NodeEdges::build(&mesh);
@@ -435,6 +436,11 @@ fn bad_seeds_are_named() {
     let err = flood_fill(&mesh, &adj, &cuts, &[seed(0.5, true)]).unwrap_err();
     assert!(matches!(err, StatusError::OccludedSeed { seed: 0, .. }), "{err}");
     assert_eq!(flood_fill(&mesh, &adj, &cuts, &[]).unwrap_err(), StatusError::NoSeed);
+    let short = [[0.0; 3]; 3];
+    let err = SurfaceAt::new(&s, &short, &bvh).err();
+    assert_eq!(err, Some(SurfaceAtError::Positions { expected: 4, got: 3 }));
+    let other = Bvh::build(&sphere([0.0; 3], 1.0, 1), 0.0);
+    assert!(matches!(SurfaceAt::at_end(&s, &other), Err(SurfaceAtError::Bvh(_))));
     // Nodes on the plane are occluded and every edge touching them is cut.
     let mask = cuts.cut_mask(mesh.n_edges());
     for (e, &[i, j]) in mesh.edges.iter().enumerate() {

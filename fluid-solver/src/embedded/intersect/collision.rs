@@ -19,6 +19,7 @@ use rayon::prelude::*;
 
 /// Cut edges and occluded nodes of `mesh` against the surface at positions `at.x` (Alg. 4.2).
 pub fn collision(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Intersections {
+    debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     let occluded = at.occluded(mesh, &adjacency.h_min, true);
     let blocks: Vec<_> = (0..mesh.blocks.len())
         .into_par_iter()

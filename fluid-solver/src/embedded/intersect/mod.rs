@@ -71,9 +71,48 @@ impl Intersections {
 /// The surface at one set of nodal positions, with the hierarchy over it.
 #[derive(Clone, Copy)]
 pub struct SurfaceAt<'a> {
-    pub surface: &'a Surface,
-    pub x: &'a [[f64; 3]],
-    pub bvh: &'a Bvh,
+    surface: &'a Surface,
+    x: &'a [[f64; 3]],
+    bvh: &'a Bvh,
+}
+
+/// A surface view whose parts do not fit together, named.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SurfaceAtError {
+    #[error("{got} nodal positions given for a surface of {expected} nodes")]
+    Positions { expected: usize, got: usize },
+    #[error(transparent)]
+    Bvh(#[from] super::bvh::BvhError),
+}
+
+impl<'a> SurfaceAt<'a> {
+    /// The view of `surface` at positions `x` (one per surface node) with its hierarchy, which
+    /// must have been built for this topology and fitted so that its boxes hold the triangles
+    /// at `x` (not checked here: [`Bvh::refit`] covers `x_a`, `x_b`).
+    pub fn new(
+        surface: &'a Surface,
+        x: &'a [[f64; 3]],
+        bvh: &'a Bvh,
+    ) -> Result<SurfaceAt<'a>, SurfaceAtError> {
+        if x.len() != surface.n_nodes() {
+            return Err(SurfaceAtError::Positions { expected: surface.n_nodes(), got: x.len() });
+        }
+        if bvh.len() != surface.triangles.len() || bvh.topology_version != surface.topology_version
+        {
+            return Err(super::bvh::BvhError::Topology {
+                surface: surface.triangles.len(),
+                tree: bvh.len(),
+                version: bvh.topology_version,
+            }
+            .into());
+        }
+        Ok(SurfaceAt { surface, x, bvh })
+    }
+
+    /// The surface at its end-of-step positions `x_b`.
+    pub fn at_end(surface: &'a Surface, bvh: &'a Bvh) -> Result<SurfaceAt<'a>, SurfaceAtError> {
+        SurfaceAt::new(surface, &surface.x_b, bvh)
+    }
 }
 
 impl SurfaceAt<'_> {

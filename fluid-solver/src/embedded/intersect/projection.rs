@@ -63,6 +63,7 @@ pub fn projection(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Inte
 
 /// Per node: inside the closed surface (Alg. 4.1 steps 1-4).
 pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Vec<bool> {
+    debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     let normals = PseudoNormals::new(at);
     // Steps 1-3: the near nodes, decided by their closest point.
     let near: Vec<Option<bool>> = (0..mesh.n_nodes())
