@@ -118,8 +118,10 @@ fn at<'a>(s: &'a Surface, bvh: &'a Bvh) -> SurfaceAt<'a> {
     SurfaceAt::at_end(s, bvh).unwrap()
 }
 
-/// The cut list is sorted, one record per edge, and each block's records are its own edges.
-fn assert_well_formed(mesh: &Mesh, cuts: &Intersections) {
+/// The cut list is sorted, one record per edge, each block's records are its own edges, and
+/// each record's point on the edge (α) is its point on the triangle (barycentric coordinates),
+/// with the triangle's unit normal.
+fn assert_well_formed(mesh: &Mesh, s: &Surface, cuts: &Intersections) {
     assert!(cuts.cuts.windows(2).all(|w| w[0].edge < w[1].edge));
     assert_eq!(cuts.block_offsets.len(), mesh.blocks.len() + 1);
     for b in 0..mesh.blocks.len() {
@@ -131,6 +133,22 @@ fn assert_well_formed(mesh: &Mesh, cuts: &Intersections) {
         assert!((0.0..=1.0).contains(&c.alpha));
         assert!((c.bary.iter().sum::<f64>() - 1.0).abs() < 1e-12);
         assert!(c.bary.iter().all(|&b| b >= -1e-15));
+        let [i, j] = mesh.edges[c.edge as usize].map(|v| mesh.coords[v as usize]);
+        let on_edge = [0, 1, 2].map(|d| i[d] + c.alpha * (j[d] - i[d]));
+        let (on_tri, _) = s.point_at(c.triangle as usize, c.bary, s.t_b);
+        let occluded_end =
+            cuts.occluded[mesh.edges[c.edge as usize][(c.alpha == 1.0) as usize] as usize];
+        for d in 0..3 {
+            let tol = if occluded_end { 1e-9 } else { 1e-12 };
+            assert!(
+                (on_edge[d] - on_tri[d]).abs() < tol,
+                "edge {}: {on_edge:?} vs {on_tri:?}",
+                c.edge
+            );
+        }
+        let t = s.triangles[c.triangle as usize].map(|n| s.x_b[n as usize]);
+        assert_eq!(c.normal, super::predicates::unit_normal(t[0], t[1], t[2]));
+        assert!((c.normal.iter().map(|v| v * v).sum::<f64>() - 1.0).abs() < 1e-14);
     }
 }
 
@@ -179,7 +197,7 @@ fn statuses_agree_with_the_winding_number_for_a_sphere_and_a_box() {
         let c42 = collision(&mesh, &adj, at(s, &bvh));
         let c41 = projection(&mesh, &adj, at(s, &bvh));
         for (alg, cuts) in [("4.2", &c42), ("4.1", &c41)] {
-            assert_well_formed(&mesh, cuts);
+            assert_well_formed(&mesh, s, cuts);
             let sides = flood_fill(&mesh, &adj, cuts, &seeds).unwrap();
             let mut checked = 0;
             for i in 0..mesh.n_nodes() {
@@ -248,6 +266,20 @@ fn thin_closed_plate_doubly_cut_edges_are_found_only_by_collision() {
     assert!(double.len() > 30);
     assert_eq!(found41, 0);
     assert_eq!(found42, double.len());
+    assert_well_formed(&mesh, &s, &c42);
+    // The record is the crossing nearest to node i.
+    for &e in &double {
+        let [i, j] = mesh.edges[e as usize].map(|v| mesh.coords[v as usize]);
+        let first = s
+            .triangles
+            .iter()
+            .filter_map(|t| {
+                let [a, b, c] = t.map(|n| s.x_b[n as usize]);
+                segment_triangle(i, j, a, b, c).map(|h| h.alpha)
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(c42.find(e).unwrap().alpha, first);
+    }
     // The fluid on both faces of the plate is one region around its rim, with no node inside.
     let sides = flood_fill(&mesh, &adj, &c42, &[Seed { point: [0.0; 3], fluid: true }]).unwrap();
     assert!(sides.status.iter().all(|&s| s == NodeStatus::Active));
@@ -279,7 +311,7 @@ fn phantom_elements_cut_only_through_their_real_part_and_never_leak() {
         let s = plate_elements(phis, zp);
         let bvh = Bvh::build(&s, PAD);
         let c = collision(&mesh, &adj, at(&s, &bvh));
-        assert_well_formed(&mesh, &c);
+        assert_well_formed(&mesh, &s, &c);
         c
     };
     // Edges crossing the plane, with the x of the crossing.
