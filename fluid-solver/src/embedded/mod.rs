@@ -8,10 +8,17 @@
 //! at every cut edge) -> `loads` (Alg. 5.3 and 5.4). The residual sees all of it through a
 //! read-only view with the stage time; `Semidiscretization` never owns the surface.
 
+pub mod adjacency;
+pub mod bvh;
 pub mod generate;
+pub mod intersect;
 pub mod motion;
+pub mod predicates;
 pub mod read;
+pub mod status;
 pub mod surface;
+#[cfg(test)]
+mod tests;
 
 pub use surface::Surface;
 

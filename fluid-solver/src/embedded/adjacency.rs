@@ -1,0 +1,108 @@
+//! The node-to-edge adjacency of the fluid mesh (compressed rows), built once per mesh: the
+//! connectivity the flood fills of Alg. 4.1 step 4 and Alg. 4.2 step 5 walk, with each node's
+//! shortest edge (the length scale of the occlusion tolerance).
+
+use crate::mesh::geometry::{norm, sub};
+use crate::mesh::Mesh;
+
+/// For each node, the edges that touch it, ascending.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeEdges {
+    /// Node `i`'s edges are `edges[offsets[i]..offsets[i + 1]]`.
+    offsets: Vec<u32>,
+    edges: Vec<u32>,
+    /// Shortest edge at each node (infinite for a node with no edge).
+    pub h_min: Vec<f64>,
+}
+
+impl NodeEdges {
+    pub fn build(mesh: &Mesh) -> NodeEdges {
+        let n = mesh.n_nodes();
+        let mut offsets = vec![0u32; n + 1];
+        for &[i, j] in &mesh.edges {
+            offsets[i as usize + 1] += 1;
+            offsets[j as usize + 1] += 1;
+        }
+        for k in 0..n {
+            offsets[k + 1] += offsets[k];
+        }
+        let mut fill = offsets.clone();
+        let mut edges = vec![0u32; 2 * mesh.n_edges()];
+        let mut h_min = vec![f64::INFINITY; n];
+        // Edges are visited in ascending order, so each row comes out sorted.
+        for (e, &[i, j]) in mesh.edges.iter().enumerate() {
+            let l = norm(sub(mesh.coords[j as usize], mesh.coords[i as usize]));
+            for v in [i as usize, j as usize] {
+                edges[fill[v] as usize] = e as u32;
+                fill[v] += 1;
+                h_min[v] = h_min[v].min(l);
+            }
+        }
+        NodeEdges { offsets, edges, h_min }
+    }
+
+    /// The edges of node `i`.
+    #[inline]
+    pub fn edges_of(&self, i: usize) -> &[u32] {
+        &self.edges[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// The neighbours of node `i`, each with the edge that joins them.
+    #[inline]
+    pub fn neighbours<'a>(
+        &'a self,
+        mesh: &'a Mesh,
+        i: usize,
+    ) -> impl Iterator<Item = (usize, u32)> + 'a {
+        self.edges_of(i).iter().map(move |&e| {
+            let [a, b] = mesh.edges[e as usize];
+            (if a as usize == i { b as usize } else { a as usize }, e)
+        })
+    }
+
+    /// The smallest box holding node `i` and its neighbours (Alg. 4.1 step 1).
+    pub fn node_box(&self, mesh: &Mesh, i: usize) -> ([f64; 3], [f64; 3]) {
+        let mut lo = mesh.coords[i];
+        let mut hi = lo;
+        for (j, _) in self.neighbours(mesh, i) {
+            let p = mesh.coords[j];
+            for d in 0..3 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Memory of the arrays in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.offsets[..])
+            + std::mem::size_of_val(&self.edges[..])
+            + std::mem::size_of_val(&self.h_min[..])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::boxmesh::{BoxCells, BoxSpec};
+
+    #[test]
+    fn every_edge_is_listed_at_both_ends() {
+        let raw = BoxSpec::uniform([0.0; 3], [1.0; 3], [3, 2, 2], BoxCells::Tet).raw().unwrap();
+        let mesh = Mesh::build(raw).unwrap();
+        let adj = NodeEdges::build(&mesh);
+        let mut count = vec![0; mesh.n_edges()];
+        for i in 0..mesh.n_nodes() {
+            let row = adj.edges_of(i);
+            assert!(row.windows(2).all(|w| w[0] < w[1]));
+            for (j, e) in adj.neighbours(&mesh, i) {
+                let [a, b] = mesh.edges[e as usize];
+                assert!((a as usize, b as usize) == (i.min(j), i.max(j)));
+                count[e as usize] += 1;
+            }
+        }
+        assert!(count.iter().all(|&c| c == 2));
+        assert_eq!(adj.h_min, mesh.min_edge_length());
+    }
+}

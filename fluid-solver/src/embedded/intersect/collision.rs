@@ -1,0 +1,49 @@
+//! Alg. 4.2 (thesis §4.3.1, collision based): every fluid edge whose box meets a triangle box is
+//! tested against that triangle with the exact crossing test of [`super::super::predicates`].
+//!
+//! - Step 3.1: a node within `OCCLUSION * h_min(i)` of a triangle (distance to its closest point,
+//!   where phi `>= 0`) is occluded.
+//! - Step 4: an edge is cut where it crosses a triangle at a point with interpolated phi `>= 0`
+//!   (§4.3.3: the crack's phantom part is not a wall); of several crossings the one nearest to
+//!   node `i` is kept. The exact test is symmetric in the two ends, so the thesis' second ray
+//!   from `j` to `i` (there to discard false positives of a rounded test) would find the same.
+//! - Step 4.2: an edge with an occluded end and no crossing is cut at that end (α = 0 or 1), on
+//!   the triangle nearest to it.
+//!
+//! Doubly cut edges of thin bodies are found, and an open surface needs no inside.
+
+use super::{Intersections, SurfaceAt};
+use crate::embedded::adjacency::NodeEdges;
+use crate::mesh::Mesh;
+use rayon::prelude::*;
+
+/// Cut edges and occluded nodes of `mesh` against the surface at positions `at.x` (Alg. 4.2).
+pub fn collision(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Intersections {
+    debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
+    let occluded = at.occluded(mesh, &adjacency.h_min, true);
+    let blocks: Vec<_> = (0..mesh.blocks.len())
+        .into_par_iter()
+        .map(|b| {
+            let mut cuts = Vec::new();
+            for e in mesh.blocks.edges(b) {
+                if let Some(c) = at.nearest_crossing(mesh, e, true) {
+                    cuts.push(c);
+                    continue;
+                }
+                let [i, j] = mesh.edges[e].map(|v| v as usize);
+                // Step 4.2: the occluded end is the intersection point.
+                for (end, alpha) in [(i, 0.0), (j, 1.0)] {
+                    if occluded[end] {
+                        let r = super::OCCLUSION * adjacency.h_min[end];
+                        if let Some((t, cp)) = at.nearest_point(mesh.coords[end], r, true) {
+                            cuts.push(at.cut(e, t, alpha, cp.bary));
+                            break;
+                        }
+                    }
+                }
+            }
+            cuts
+        })
+        .collect();
+    Intersections::from_blocks(blocks, occluded)
+}

@@ -1,0 +1,194 @@
+//! The cut edges of the fluid mesh (thesis §4.2-4.3): [`collision`] is Alg. 4.2 (every edge
+//! tested against the triangles near it; open, thin and unresolved surfaces, cracks through phi),
+//! [`projection`] is Alg. 4.1 (sides by projection and flood fill; closed, resolved surfaces).
+//! Both return [`Intersections`]: one [`CutEdge`] per cut edge, sorted by edge, with the offsets
+//! of each edge block of [`crate::mesh::EdgeBlocks`], and the occluded nodes.
+//!
+//! The surface is taken at one set of nodal positions `x` (for example `Surface::x_b`, or
+//! `Surface::node_at` at a stage time); the hierarchy's boxes must hold the triangles there
+//! ([`super::bvh::Bvh::refit`] covers `x_a` and `x_b`, [`super::bvh::Bvh::refit_with`] any other).
+
+pub mod collision;
+pub mod projection;
+
+pub use collision::collision;
+pub use projection::{projection, projection_inside};
+
+use super::bvh::Bvh;
+use super::predicates::{closest_point, segment_triangle, unit_normal, Closest};
+use super::{CutEdge, Surface};
+use crate::mesh::Mesh;
+
+/// Occlusion tolerance (thesis §4.3.2, `ε = 1e-8`), relative to the node's shortest edge: a node
+/// closer than `OCCLUSION * h_min(i)` to a triangle (where that triangle's phi is `>= 0`) is
+/// occluded.
+pub const OCCLUSION: f64 = 1e-8;
+
+/// The cut edges of a mesh at one time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Intersections {
+    /// Sorted by `edge`, one per cut edge.
+    pub cuts: Vec<CutEdge>,
+    /// Block `b`'s cut edges are `cuts[block_offsets[b]..block_offsets[b + 1]]`.
+    pub block_offsets: Vec<u32>,
+    /// Per node: within the occlusion tolerance of the surface.
+    pub occluded: Vec<bool>,
+}
+
+impl Intersections {
+    /// The cut edges of block `b`.
+    pub fn block(&self, b: usize) -> &[CutEdge] {
+        &self.cuts[self.block_offsets[b] as usize..self.block_offsets[b + 1] as usize]
+    }
+
+    /// The record of edge `e`, if it is cut.
+    pub fn find(&self, e: u32) -> Option<&CutEdge> {
+        self.cuts.binary_search_by_key(&e, |c| c.edge).ok().map(|k| &self.cuts[k])
+    }
+
+    /// Per edge: whether it is cut.
+    pub fn cut_mask(&self, n_edges: usize) -> Vec<bool> {
+        let mut m = vec![false; n_edges];
+        for c in &self.cuts {
+            m[c.edge as usize] = true;
+        }
+        m
+    }
+
+    /// Gathers the per-block lists (in block order) into one sorted list with offsets.
+    fn from_blocks(blocks: Vec<Vec<CutEdge>>, occluded: Vec<bool>) -> Intersections {
+        let mut block_offsets = Vec::with_capacity(blocks.len() + 1);
+        block_offsets.push(0);
+        let mut cuts = Vec::with_capacity(blocks.iter().map(Vec::len).sum());
+        for b in blocks {
+            cuts.extend_from_slice(&b);
+            block_offsets.push(cuts.len() as u32);
+        }
+        Intersections { cuts, block_offsets, occluded }
+    }
+}
+
+/// The surface at one set of nodal positions, with the hierarchy over it.
+#[derive(Clone, Copy)]
+pub struct SurfaceAt<'a> {
+    surface: &'a Surface,
+    x: &'a [[f64; 3]],
+    bvh: &'a Bvh,
+}
+
+/// A surface view whose parts do not fit together, named.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SurfaceAtError {
+    #[error("{got} nodal positions given for a surface of {expected} nodes")]
+    Positions { expected: usize, got: usize },
+    #[error(transparent)]
+    Bvh(#[from] super::bvh::BvhError),
+}
+
+impl<'a> SurfaceAt<'a> {
+    /// The view of `surface` at positions `x` (one per surface node) with its hierarchy, which
+    /// must have been built for this topology and fitted so that its boxes hold the triangles
+    /// at `x` (not checked here: [`Bvh::refit`] covers `x_a`, `x_b`).
+    pub fn new(
+        surface: &'a Surface,
+        x: &'a [[f64; 3]],
+        bvh: &'a Bvh,
+    ) -> Result<SurfaceAt<'a>, SurfaceAtError> {
+        if x.len() != surface.n_nodes() {
+            return Err(SurfaceAtError::Positions { expected: surface.n_nodes(), got: x.len() });
+        }
+        if bvh.len() != surface.triangles.len() || bvh.topology_version != surface.topology_version
+        {
+            return Err(super::bvh::BvhError::Topology {
+                surface: surface.triangles.len(),
+                tree: bvh.len(),
+                version: bvh.topology_version,
+            }
+            .into());
+        }
+        Ok(SurfaceAt { surface, x, bvh })
+    }
+
+    /// The surface at its end-of-step positions `x_b`.
+    pub fn at_end(surface: &'a Surface, bvh: &'a Bvh) -> Result<SurfaceAt<'a>, SurfaceAtError> {
+        SurfaceAt::new(surface, &surface.x_b, bvh)
+    }
+}
+
+impl SurfaceAt<'_> {
+    #[inline]
+    fn corners(&self, t: u32) -> [[f64; 3]; 3] {
+        self.surface.triangles[t as usize].map(|n| self.x[n as usize])
+    }
+
+    /// Interpolated phi at a point of triangle `t`.
+    #[inline]
+    fn phi(&self, t: u32, bary: [f64; 3]) -> f64 {
+        let p = self.surface.phi[t as usize];
+        bary[0] * p[0] + bary[1] * p[1] + bary[2] * p[2]
+    }
+
+    /// The cut record of edge `e` for triangle `t` at `(α, bary)`.
+    fn cut(&self, e: usize, t: u32, alpha: f64, bary: [f64; 3]) -> CutEdge {
+        let [a, b, c] = self.corners(t);
+        CutEdge { edge: e as u32, alpha, triangle: t, bary, normal: unit_normal(a, b, c) }
+    }
+
+    /// The crossing of edge `e` nearest to its node `i` (smallest α, then lowest triangle), among
+    /// the triangles whose box meets the edge's box, counting only hits where phi `>= 0` when
+    /// `crack_aware`.
+    fn nearest_crossing(&self, mesh: &Mesh, e: usize, crack_aware: bool) -> Option<CutEdge> {
+        let [i, j] = mesh.edges[e];
+        let (p, q) = (mesh.coords[i as usize], mesh.coords[j as usize]);
+        let lo = [0, 1, 2].map(|d| p[d].min(q[d]));
+        let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
+        let mut best: Option<(f64, u32, [f64; 3])> = None;
+        self.bvh.for_each_overlap(&lo, &hi, |t| {
+            let [a, b, c] = self.corners(t);
+            if let Some(h) = segment_triangle(p, q, a, b, c) {
+                if crack_aware && !(self.phi(t, h.bary) >= 0.0) {
+                    return;
+                }
+                if best.is_none_or(|(al, bt, _)| (h.alpha, t) < (al, bt)) {
+                    best = Some((h.alpha, t, h.bary));
+                }
+            }
+        });
+        best.map(|(alpha, t, bary)| self.cut(e, t, alpha, bary))
+    }
+
+    /// The closest point of the surface to `p` among the triangles whose box meets the box of
+    /// half-width `radius` around it (lowest triangle on ties), with phi `>= 0` there when
+    /// `crack_aware`.
+    fn nearest_point(&self, p: [f64; 3], radius: f64, crack_aware: bool) -> Option<(u32, Closest)> {
+        let lo = p.map(|v| v - radius);
+        let hi = p.map(|v| v + radius);
+        let mut best: Option<(u32, Closest)> = None;
+        self.bvh.for_each_overlap(&lo, &hi, |t| {
+            let [a, b, c] = self.corners(t);
+            let cp = closest_point(p, a, b, c);
+            if crack_aware && !(self.phi(t, cp.bary) >= 0.0) {
+                return;
+            }
+            if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
+                best = Some((t, cp));
+            }
+        });
+        best
+    }
+
+    /// Occluded nodes (Alg. 4.2 step 3.1): within `OCCLUSION * h_min(i)` of the surface.
+    fn occluded(&self, mesh: &Mesh, h_min: &[f64], crack_aware: bool) -> Vec<bool> {
+        use rayon::prelude::*;
+        (0..mesh.n_nodes())
+            .into_par_iter()
+            .map(|i| {
+                let r = OCCLUSION * h_min[i];
+                r.is_finite()
+                    && self
+                        .nearest_point(mesh.coords[i], r, crack_aware)
+                        .is_some_and(|(_, c)| c.dist2 <= r * r)
+            })
+            .collect()
+    }
+}

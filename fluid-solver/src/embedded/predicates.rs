@@ -1,0 +1,371 @@
+//! Geometric predicates of the interface tracking (thesis §4.2.1 and §4.3): the exact orientation
+//! of four points (Shewchuk's adaptive `orient3d` through the `robust` crate), the crossing of a
+//! fluid edge with a surface triangle, the closest point of a triangle to a node, and the instant
+//! at which a moving triangle passes over a fixed node (continuous collision, Alg. 4.2 step 5.1).
+//!
+//! The crossing test decides every sign exactly, so it has no tolerance: a triangle is closed (its
+//! edges and vertices belong to it), hence an edge through the common edge or vertex of several
+//! triangles is found by each of them, and no edge slips between two triangles that share an
+//! edge. The positions returned (α along the edge, barycentric coordinates) are rounded values
+//! computed from the same determinants.
+
+use crate::mesh::geometry::{add, cross, dot, scale, sub};
+
+/// Orientation of `d` against the plane of the triangle `(a, b, c)`: positive where the normal
+/// `(b - a) × (c - a)` points, negative on the other side, zero exactly when the four points are
+/// coplanar. The sign is exact; the magnitude is six times the signed volume, rounded.
+#[inline]
+pub fn orient(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
+    let p = |x: [f64; 3]| robust::Coord3D { x: x[0], y: x[1], z: x[2] };
+    // Shewchuk's orient3d is positive when d lies below the plane seen with abc counterclockwise.
+    -robust::orient3d(p(a), p(b), p(c), p(d))
+}
+
+/// Where a fluid edge crosses a triangle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeHit {
+    /// `x = p + α (q - p)`, `α ∈ [0, 1]`.
+    pub alpha: f64,
+    /// Barycentric coordinates of the crossing in the triangle (each `>= 0`, sum 1).
+    pub bary: [f64; 3],
+}
+
+/// The crossing of the segment `p q` with the closed triangle `(a, b, c)`, if any.
+///
+/// The segment crosses when its ends are not strictly on one side of the triangle's plane and
+/// the line `p q` passes through the closed triangle: the three orientations of `p, q` against
+/// the triangle's edges do not take both signs. A segment lying in the plane of the triangle
+/// (both ends coplanar) is not a crossing, whatever it touches. With the volumes
+/// `V_a = orient(p, q, b, c)`, `V_b = orient(p, q, c, a)`, `V_c = orient(p, q, a, b)` the
+/// barycentric coordinates are `V_k / ΣV`, and `α = s_p / (s_p - s_q)` with `s = orient(a, b, c, ·)`.
+pub fn segment_triangle(
+    p: [f64; 3],
+    q: [f64; 3],
+    a: [f64; 3],
+    b: [f64; 3],
+    c: [f64; 3],
+) -> Option<EdgeHit> {
+    let sp = orient(a, b, c, p);
+    let sq = orient(a, b, c, q);
+    if (sp == 0.0 && sq == 0.0) || (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
+        return None;
+    }
+    let v = [orient(p, q, b, c), orient(p, q, c, a), orient(p, q, a, b)];
+    let pos = v.iter().any(|&x| x > 0.0);
+    let neg = v.iter().any(|&x| x < 0.0);
+    if pos && neg {
+        return None;
+    }
+    // Not coplanar, so the line meets the plane in one point and the volumes share one sign.
+    let sum = v[0] + v[1] + v[2];
+    let bary = [v[0] / sum, v[1] / sum, v[2] / sum];
+    let alpha = (sp / (sp - sq)).clamp(0.0, 1.0);
+    Some(EdgeHit { alpha, bary })
+}
+
+/// The part of a triangle that holds the closest point to a node: its interior, the edge opposite
+/// corner `k` (the edge `(k+1, k+2)`), or corner `k`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Feature {
+    Face,
+    Edge(u8),
+    Vertex(u8),
+}
+
+/// The closest point of a triangle to a node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Closest {
+    /// Squared distance from the node.
+    pub dist2: f64,
+    /// Barycentric coordinates of the closest point (each `>= 0`, sum 1).
+    pub bary: [f64; 3],
+    pub feature: Feature,
+}
+
+/// Closest point of the triangle `(a, b, c)` to `p` (thesis §4.2.1: the projection onto the plane
+/// when its barycentric coordinates are all non-negative, else onto an edge, else a corner), by
+/// the Voronoi regions of the corners and edges (Ericson, Real-Time Collision Detection §5.1.5).
+/// A degenerate triangle (zero area) returns its nearest corner.
+pub fn closest_point(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Closest {
+    let at = |bary: [f64; 3], feature| {
+        let x = add(add(scale(a, bary[0]), scale(b, bary[1])), scale(c, bary[2]));
+        let d = sub(p, x);
+        Closest { dist2: dot(d, d), bary, feature }
+    };
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return at([1.0, 0.0, 0.0], Feature::Vertex(0));
+    }
+    let bp = sub(p, b);
+    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return at([0.0, 1.0, 0.0], Feature::Vertex(1));
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return at([1.0 - v, v, 0.0], Feature::Edge(2));
+    }
+    let cp = sub(p, c);
+    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return at([0.0, 0.0, 1.0], Feature::Vertex(2));
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return at([1.0 - w, 0.0, w], Feature::Edge(1));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return at([0.0, 1.0 - w, w], Feature::Edge(0));
+    }
+    let denom = va + vb + vc;
+    if denom.abs() <= f64::MIN_POSITIVE {
+        // Zero area (the Voronoi tests above are then inconclusive): the nearest corner.
+        return [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+            .into_iter()
+            .enumerate()
+            .map(|(k, bary)| at(bary, Feature::Vertex(k as u8)))
+            .fold(
+                at([1.0, 0.0, 0.0], Feature::Vertex(0)),
+                |m, x| if x.dist2 < m.dist2 { x } else { m },
+            );
+    }
+    let (v, w) = (vb / denom, vc / denom);
+    at([1.0 - v - w, v, w], Feature::Face)
+}
+
+/// Unit normal `(b - a) × (c - a) / |…|` of a triangle (zero for a degenerate one).
+#[inline]
+pub fn unit_normal(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
+    let n = cross(sub(b, a), sub(c, a));
+    let l = dot(n, n).sqrt();
+    if l > 0.0 {
+        scale(n, 1.0 / l)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Bisection steps for a crossing instant: the bracket shrinks below `2^-52` of the step.
+const SWEEP_BISECTIONS: usize = 52;
+/// Barycentric slack of the inside test at the crossing instant (the instant is rounded).
+const SWEEP_BARY_SLACK: f64 = 1e-9;
+
+/// The first fraction `s ∈ [0, 1]` of the step at which the triangle moving linearly from
+/// `(a0, b0, c0)` to `(a1, b1, c1)` passes over the fixed point `p`: the instant `p` is coplanar
+/// with it (a root of the cubic `f(s) = orient(a(s), b(s), c(s), p)`) and lies inside it (thesis
+/// Alg. 4.2 step 5.1; the triangle moves on the straight line between its positions at `t_a` and
+/// `t_b`, not on the Hermite path: the swept boxes of the hierarchy hold exactly this motion).
+///
+/// The cubic is split at the roots of its derivative into monotone pieces and each piece with a
+/// sign change is bisected on `f` itself; the signs at `s = 0` and `s = 1` are exact. A point
+/// that stays in the plane of the triangle for the whole step is not swept (nothing crosses it).
+pub fn sweep_over_point(p: [f64; 3], from: [[f64; 3]; 3], to: [[f64; 3]; 3]) -> Option<f64> {
+    let corners = |s: f64| {
+        let m = |k: usize| add(from[k], scale(sub(to[k], from[k]), s));
+        [m(0), m(1), m(2)]
+    };
+    let f = |s: f64| {
+        let [a, b, c] = corners(s);
+        if s == 0.0 || s == 1.0 {
+            orient(a, b, c, p)
+        } else {
+            dot(cross(sub(b, a), sub(c, a)), sub(p, a))
+        }
+    };
+    // The cubic through f at s = 0, 1/3, 2/3, 1, in the monomial basis c0 + c1 s + c2 s² + c3 s³.
+    let (f0, f1, f2, f3) = (f(0.0), f(1.0 / 3.0), f(2.0 / 3.0), f(1.0));
+    let c1 = (-11.0 * f0 + 18.0 * f1 - 9.0 * f2 + 2.0 * f3) / 2.0;
+    let c2 = (18.0 * f0 - 45.0 * f1 + 36.0 * f2 - 9.0 * f3) / 2.0;
+    let c3 = (-9.0 * f0 + 27.0 * f1 - 27.0 * f2 + 9.0 * f3) / 2.0;
+    // Break points: 0, the derivative's roots in (0, 1), 1.
+    let mut cuts = [0.0, 1.0, 1.0, 1.0];
+    let mut n = 1;
+    let (qa, qb, qc) = (3.0 * c3, 2.0 * c2, c1);
+    let scale_q = qa.abs().max(qb.abs()).max(qc.abs());
+    if scale_q > 0.0 {
+        let mut push = |r: f64| {
+            if r > 0.0 && r < 1.0 {
+                cuts[n] = r;
+                n += 1;
+            }
+        };
+        if qa.abs() > 1e-12 * scale_q {
+            let disc = qb * qb - 4.0 * qa * qc;
+            if disc >= 0.0 {
+                let sq = disc.sqrt();
+                let qq = -0.5 * (qb + qb.signum() * sq);
+                if qq != 0.0 {
+                    push(qq / qa);
+                    push(qc / qq);
+                } else {
+                    push(0.0);
+                }
+            }
+        } else if qb != 0.0 {
+            push(-qc / qb);
+        }
+    }
+    cuts[n] = 1.0;
+    cuts[..=n].sort_by(f64::total_cmp);
+    for k in 0..n {
+        let (mut lo, mut hi) = (cuts[k], cuts[k + 1]);
+        let (mut flo, fhi) = (f(lo), f(hi));
+        let root = if flo == 0.0 {
+            lo
+        } else if fhi == 0.0 {
+            hi
+        } else if (flo > 0.0) != (fhi > 0.0) {
+            for _ in 0..SWEEP_BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                let fm = f(mid);
+                if (fm > 0.0) == (flo > 0.0) && fm != 0.0 {
+                    lo = mid;
+                    flo = fm;
+                } else {
+                    hi = mid;
+                }
+            }
+            0.5 * (lo + hi)
+        } else {
+            continue;
+        };
+        let [a, b, c] = corners(root);
+        let cp = closest_point(p, a, b, c);
+        let size = dot(sub(b, a), sub(b, a)).max(dot(sub(c, a), sub(c, a)));
+        if cp.dist2 <= SWEEP_BARY_SLACK * SWEEP_BARY_SLACK * size {
+            // Not an instant of the whole step in the plane (f ≡ 0 has no crossing).
+            if f0 == 0.0 && f3 == 0.0 && f1 == 0.0 && f2 == 0.0 {
+                return None;
+            }
+            return Some(root);
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const A: [f64; 3] = [0.0, 0.0, 0.0];
+    const B: [f64; 3] = [1.0, 0.0, 0.0];
+    const C: [f64; 3] = [0.0, 1.0, 0.0];
+    const D: [f64; 3] = [1.0, 1.0, 0.0];
+
+    #[test]
+    fn orientation_sign_follows_the_normal() {
+        assert!(orient(A, B, C, [0.2, 0.2, 1.0]) > 0.0);
+        assert!(orient(A, B, C, [0.2, 0.2, -1e-300]) < 0.0);
+        assert_eq!(orient(A, B, C, [5.0, -3.0, 0.0]), 0.0);
+        // Exactly on the plane x + y + z = 1, and one ulp off it.
+        let (a, b, c) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        assert_eq!(orient(a, b, c, [0.125, 0.375, 0.5]), 0.0);
+        assert!(orient(a, b, c, [0.125, 0.375, 0.5 + f64::EPSILON / 2.0]) > 0.0);
+        assert!(orient(a, b, c, [0.125 - f64::EPSILON / 16.0, 0.375, 0.5]) < 0.0);
+    }
+
+    #[test]
+    fn crossing_gives_alpha_and_barycentrics() {
+        let h = segment_triangle([0.2, 0.3, -1.0], [0.2, 0.3, 3.0], A, B, C).unwrap();
+        assert!((h.alpha - 0.25).abs() < 1e-15);
+        let x = [0.5, 0.2, 0.3];
+        for k in 0..3 {
+            assert!((h.bary[k] - x[k]).abs() < 1e-15, "{:?}", h.bary);
+        }
+        assert!(segment_triangle([0.6, 0.6, -1.0], [0.6, 0.6, 1.0], A, B, C).is_none());
+        assert!(segment_triangle([0.2, 0.2, 0.5], [0.2, 0.2, 1.0], A, B, C).is_none());
+    }
+
+    /// The square `A B D C` as two triangles sharing the diagonal `B C`.
+    fn square_hits(p: [f64; 3], q: [f64; 3]) -> Vec<EdgeHit> {
+        [[A, B, C], [B, D, C]]
+            .iter()
+            .filter_map(|t| segment_triangle(p, q, t[0], t[1], t[2]))
+            .collect()
+    }
+
+    #[test]
+    fn edge_through_a_shared_edge_is_found_by_both_triangles() {
+        // Through the diagonal x + y = 1 (exactly: 0.3 + 0.7 is not 1 in binary, 0.375 + 0.625 is).
+        let (x, y) = (0.375, 0.625);
+        let hits = square_hits([x, y, -0.1], [x, y, 0.3]);
+        assert_eq!(hits.len(), 2);
+        for h in &hits {
+            assert!((h.alpha - 0.25).abs() < 1e-15);
+        }
+        // Slanted edges through many points of the diagonal: never a leak between the two.
+        for k in 1..200 {
+            let s = k as f64 / 200.0 + 1e-3 * (k as f64).sin();
+            let m = [s, 1.0 - s, 0.0];
+            let d = [0.31, -0.17, 0.9];
+            let hits = square_hits(sub(m, scale(d, 0.37)), add(m, scale(d, 0.63)));
+            assert!(!hits.is_empty() && hits.len() <= 2, "{k}: {} hits", hits.len());
+        }
+    }
+
+    #[test]
+    fn edge_through_a_vertex_is_found() {
+        assert_eq!(square_hits([0.0, 0.0, -1.0], [0.0, 0.0, 1.0]).len(), 1);
+        assert_eq!(square_hits([1.0, 0.0, -1.0], [1.0, 0.0, 1.0]).len(), 2);
+        // A fan of six triangles around the origin: each reports the shared vertex.
+        let ring: Vec<[f64; 3]> = (0..6)
+            .map(|k| {
+                let t = k as f64 * std::f64::consts::PI / 3.0;
+                [t.cos(), t.sin(), 0.1 * t.sin()]
+            })
+            .collect();
+        let hits = (0..6)
+            .filter_map(|k| {
+                segment_triangle([0.0, 0.0, -1.0], [0.0, 0.0, 2.0], A, ring[k], ring[(k + 1) % 6])
+            })
+            .count();
+        assert_eq!(hits, 6);
+    }
+
+    #[test]
+    fn coplanar_edges_are_not_crossings() {
+        assert!(square_hits([-0.5, 0.5, 0.0], [1.5, 0.5, 0.0]).is_empty());
+        assert!(square_hits([0.2, 0.2, 0.0], [0.3, 0.3, 0.0]).is_empty());
+        // An edge ending on the triangle's face crosses it at α = 1.
+        let h = segment_triangle([0.2, 0.2, 1.0], [0.2, 0.2, 0.0], A, B, C).unwrap();
+        assert_eq!(h.alpha, 1.0);
+    }
+
+    #[test]
+    fn closest_point_in_each_region() {
+        let c = closest_point([0.2, 0.3, 2.0], A, B, C);
+        assert_eq!(c.feature, Feature::Face);
+        assert!((c.dist2 - 4.0).abs() < 1e-14);
+        let c = closest_point([0.5, -1.0, 1.0], A, B, C);
+        assert_eq!(c.feature, Feature::Edge(2));
+        assert!((c.dist2 - 2.0).abs() < 1e-14 && (c.bary[1] - 0.5).abs() < 1e-15);
+        let c = closest_point([1.0, 1.0, 0.0], A, B, C);
+        assert_eq!(c.feature, Feature::Edge(0));
+        assert!((c.dist2 - 0.5).abs() < 1e-14);
+        let c = closest_point([-1.0, -2.0, 0.0], A, B, C);
+        assert_eq!(c.feature, Feature::Vertex(0));
+        assert!((c.dist2 - 5.0).abs() < 1e-14);
+        assert_eq!(closest_point([0.0, 3.0, 0.0], A, B, C).feature, Feature::Vertex(2));
+    }
+
+    #[test]
+    fn moving_triangle_sweeps_the_points_it_passes() {
+        let up = |z: f64| [[0.0, 0.0, z], [1.0, 0.0, z], [0.0, 1.0, z]];
+        let s = sweep_over_point([0.2, 0.2, 0.3], up(0.0), up(1.0)).unwrap();
+        assert!((s - 0.3).abs() < 1e-14);
+        assert!(sweep_over_point([0.2, 0.2, 1.3], up(0.0), up(1.0)).is_none());
+        assert!(sweep_over_point([0.8, 0.8, 0.3], up(0.0), up(1.0)).is_none());
+        assert!(sweep_over_point([0.2, 0.2, 0.0], up(0.0), up(0.0)).is_none());
+        // A rotating triangle: the plane through the x axis turns from z = 0 to y = 0 (a cubic
+        // in s because the corner moves on a chord); the point at angle 45° is passed half way.
+        let from = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 1.0, 0.0]];
+        let to = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 0.0, 1.0]];
+        let s = sweep_over_point([1.0, 0.3, 0.3], from, to).unwrap();
+        assert!((s - 0.5).abs() < 1e-12, "{s}");
+    }
+}

@@ -1,0 +1,264 @@
+//! Node status and sides (thesis Alg. 4.2 step 5 and its t = 0 form 5'; §4.4's step limit).
+//!
+//! A side is a connected component of the fluid mesh reached without crossing a cut edge or
+//! entering an occluded node. At t = 0 the components are found by a flood fill and classified by
+//! seeds given by the user (a point and whether its region is fluid); unseeded components are
+//! inside the structure (inactive). Occluded nodes are inactive and belong to no side (§4.3:
+//! "always considered to be inside S"). Between two steps only the nodes a triangle passed over
+//! ([`swept_nodes`]) and the occluded ones are redecided: they take the side of a visible
+//! neighbour (one joined by an uncut edge) whose side is known (Alg. 4.2 step 5.2);
+//! [`update_sides`] returns the nodes whose side or status changed, for the solver to fill.
+
+use super::adjacency::NodeEdges;
+use super::bvh::Bvh;
+use super::intersect::Intersections;
+use super::predicates::sweep_over_point;
+use super::Surface;
+use crate::mesh::geometry::{norm, sub};
+use crate::mesh::Mesh;
+use rayon::prelude::*;
+
+/// Side of a node that has none (occluded, or left undecided by a step: inside the structure).
+pub const NO_SIDE: u32 = u32::MAX;
+
+/// What the solver does with a node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum NodeStatus {
+    /// A fluid node: it carries a state and its fluxes are computed.
+    Active,
+    /// Within the occlusion tolerance of the surface: inactive, no side.
+    Occluded,
+    /// Inside the structure (a region no fluid seed reaches).
+    Inactive,
+}
+
+/// A user-given point classifying the region around it at t = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Seed {
+    pub point: [f64; 3],
+    /// Whether the region holding the point is fluid (else it is inside a body).
+    pub fluid: bool,
+}
+
+/// Status and side of every node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeSides {
+    pub status: Vec<NodeStatus>,
+    /// Side id per node ([`NO_SIDE`] for occluded and undecided nodes).
+    pub side: Vec<u32>,
+    /// Per side id: whether it is fluid.
+    pub side_fluid: Vec<bool>,
+}
+
+/// A node whose side or status changed in a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SideChange {
+    pub node: u32,
+    pub old_side: u32,
+    pub new_side: u32,
+    pub old_status: NodeStatus,
+    pub new_status: NodeStatus,
+}
+
+/// Seeds that cannot classify the mesh, named.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StatusError {
+    #[error("seed {seed} at {point:?}: its nearest mesh node {node} is occluded by the surface; move the seed at least one cell away from it")]
+    OccludedSeed { seed: usize, point: [f64; 3], node: usize },
+    #[error("seeds {first} (fluid: {first_fluid}) and {second} (fluid: {second_fluid}) lie in one connected region of the fluid mesh: the surface does not separate them (a leak, or a misplaced seed)")]
+    Conflict { first: usize, first_fluid: bool, second: usize, second_fluid: bool },
+    #[error("seed {seed} has a non-finite point {point:?}")]
+    BadSeed { seed: usize, point: [f64; 3] },
+    #[error("no seed given: at least one point in the fluid is needed")]
+    NoSeed,
+}
+
+/// Sides and statuses at t = 0 (Alg. 4.2 step 5'): components of the mesh through uncut edges,
+/// classified by the seeds (each seed goes to its nearest mesh node).
+pub fn flood_fill(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    cuts: &Intersections,
+    seeds: &[Seed],
+) -> Result<NodeSides, StatusError> {
+    if seeds.is_empty() {
+        return Err(StatusError::NoSeed);
+    }
+    let n = mesh.n_nodes();
+    debug_assert_eq!(cuts.occluded.len(), n, "intersections of another mesh");
+    let cut = cuts.cut_mask(mesh.n_edges());
+    let mut side = vec![NO_SIDE; n];
+    let mut queue = Vec::new();
+    let mut n_sides = 0u32;
+    for start in 0..n {
+        if side[start] != NO_SIDE || cuts.occluded[start] {
+            continue;
+        }
+        side[start] = n_sides;
+        queue.clear();
+        queue.push(start);
+        let mut head = 0;
+        while head < queue.len() {
+            let i = queue[head];
+            head += 1;
+            for (j, e) in adjacency.neighbours(mesh, i) {
+                if !cut[e as usize] && !cuts.occluded[j] && side[j] == NO_SIDE {
+                    side[j] = n_sides;
+                    queue.push(j);
+                }
+            }
+        }
+        n_sides += 1;
+    }
+    let mut classified: Vec<Option<(usize, bool)>> = vec![None; n_sides as usize];
+    for (k, s) in seeds.iter().enumerate() {
+        if !s.point.iter().all(|v| v.is_finite()) {
+            return Err(StatusError::BadSeed { seed: k, point: s.point });
+        }
+        let node = (0..n)
+            .min_by(|&a, &b| {
+                let d = |i: usize| norm(sub(mesh.coords[i], s.point));
+                d(a).total_cmp(&d(b))
+            })
+            .ok_or(StatusError::NoSeed)?;
+        if cuts.occluded[node] {
+            return Err(StatusError::OccludedSeed { seed: k, point: s.point, node });
+        }
+        match classified[side[node] as usize] {
+            Some((first, fluid)) if fluid != s.fluid => {
+                return Err(StatusError::Conflict {
+                    first,
+                    first_fluid: fluid,
+                    second: k,
+                    second_fluid: s.fluid,
+                })
+            }
+            Some(_) => {}
+            None => classified[side[node] as usize] = Some((k, s.fluid)),
+        }
+    }
+    let side_fluid: Vec<bool> = classified.iter().map(|c| c.is_some_and(|(_, f)| f)).collect();
+    let status = statuses(&side, &side_fluid, &cuts.occluded);
+    Ok(NodeSides { status, side, side_fluid })
+}
+
+/// The nodes a triangle passed over between `x_a` and `x_b` (Alg. 4.2 step 5.1, point against a
+/// linearly moving triangle), ascending. The hierarchy must be fitted to the step ([`Bvh::refit`]).
+pub fn swept_nodes(mesh: &Mesh, surface: &Surface, bvh: &Bvh) -> Vec<u32> {
+    (0..mesh.n_nodes() as u32)
+        .into_par_iter()
+        .filter(|&i| {
+            let p = mesh.coords[i as usize];
+            let mut swept = false;
+            bvh.for_each_overlap(&p, &p, |t| {
+                if !swept {
+                    let tri = surface.triangles[t as usize];
+                    let from = tri.map(|n| surface.x_a[n as usize]);
+                    let to = tri.map(|n| surface.x_b[n as usize]);
+                    swept = sweep_over_point(p, from, to).is_some();
+                }
+            });
+            swept
+        })
+        .collect()
+}
+
+/// Sides after a step (Alg. 4.2 step 5.2): the swept nodes and the nodes occluded before or now
+/// are redecided from their visible neighbours of known side, through the new cut edges, by a
+/// flood fill in node order; those that reach none are inactive. Returns the new sides and the
+/// nodes whose side or status changed (ascending).
+pub fn update_sides(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    old: &NodeSides,
+    cuts: &Intersections,
+    swept: &[u32],
+) -> (NodeSides, Vec<SideChange>) {
+    let n = mesh.n_nodes();
+    debug_assert!(old.side.len() == n && cuts.occluded.len() == n, "sides of another mesh");
+    let cut = cuts.cut_mask(mesh.n_edges());
+    let mut side = old.side.clone();
+    for &i in swept {
+        side[i as usize] = NO_SIDE;
+    }
+    for i in 0..n {
+        if cuts.occluded[i] {
+            side[i] = NO_SIDE;
+        }
+    }
+    let unknown: Vec<bool> = (0..n).map(|i| side[i] == NO_SIDE && !cuts.occluded[i]).collect();
+    let mut queue: Vec<usize> = (0..n)
+        .filter(|&i| {
+            side[i] != NO_SIDE
+                && adjacency.neighbours(mesh, i).any(|(j, e)| unknown[j] && !cut[e as usize])
+        })
+        .collect();
+    let mut head = 0;
+    while head < queue.len() {
+        let i = queue[head];
+        head += 1;
+        for (j, e) in adjacency.neighbours(mesh, i) {
+            if unknown[j] && side[j] == NO_SIDE && !cut[e as usize] {
+                side[j] = side[i];
+                queue.push(j);
+            }
+        }
+    }
+    let status = statuses(&side, &old.side_fluid, &cuts.occluded);
+    let changes = (0..n)
+        .filter(|&i| side[i] != old.side[i] || status[i] != old.status[i])
+        .map(|i| SideChange {
+            node: i as u32,
+            old_side: old.side[i],
+            new_side: side[i],
+            old_status: old.status[i],
+            new_status: status[i],
+        })
+        .collect();
+    (NodeSides { status, side, side_fluid: old.side_fluid.clone() }, changes)
+}
+
+fn statuses(side: &[u32], side_fluid: &[bool], occluded: &[bool]) -> Vec<NodeStatus> {
+    (0..side.len())
+        .map(|i| {
+            if occluded[i] {
+                NodeStatus::Occluded
+            } else if side[i] != NO_SIDE && side_fluid[side[i] as usize] {
+                NodeStatus::Active
+            } else {
+                NodeStatus::Inactive
+            }
+        })
+        .collect()
+}
+
+/// The step limit of thesis §4.4: the largest ratio, over the surface nodes, of the distance the
+/// node moves from `x_a` to `x_b` to the shortest fluid edge near it. "Near" is the shortest
+/// edge cut by a triangle touching the node; a node whose triangles cut no edge takes the
+/// shortest cut edge of all (the whole mesh's shortest edge if nothing is cut). A ratio `<= 1`
+/// keeps every surface node within one edge length per step.
+pub fn step_ratio(mesh: &Mesh, surface: &Surface, cuts: &Intersections) -> f64 {
+    let length = |e: u32| {
+        let [i, j] = mesh.edges[e as usize];
+        norm(sub(mesh.coords[j as usize], mesh.coords[i as usize]))
+    };
+    let mut h = vec![f64::INFINITY; surface.n_nodes()];
+    let mut h_all = f64::INFINITY;
+    for c in &cuts.cuts {
+        let l = length(c.edge);
+        h_all = h_all.min(l);
+        for &v in &surface.triangles[c.triangle as usize] {
+            h[v as usize] = h[v as usize].min(l);
+        }
+    }
+    if !h_all.is_finite() {
+        h_all = (0..mesh.n_edges() as u32).map(length).fold(f64::INFINITY, f64::min);
+    }
+    (0..surface.n_nodes())
+        .map(|v| {
+            let hv = if h[v].is_finite() { h[v] } else { h_all };
+            norm(sub(surface.x_b[v], surface.x_a[v])) / hv
+        })
+        .fold(0.0, f64::max)
+}
