@@ -8,7 +8,11 @@
 //! at every cut edge) -> `loads` (Alg. 5.3 and 5.4). The residual sees all of it through a
 //! read-only view with the stage time; `Semidiscretization` never owns the surface.
 
+pub mod loads;
+pub mod riemann_fs;
 pub mod surface;
+#[cfg(test)]
+pub(crate) mod test_cuts;
 
 pub use surface::Surface;
 
