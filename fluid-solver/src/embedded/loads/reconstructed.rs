@@ -18,7 +18,6 @@
 //! shape functions at the projection (Eq. 5.18). The resultant is `Σ ∫ q n̂` exactly (Eq. 5.19).
 
 use super::{distribute, or_zero, LoadView};
-use crate::embedded::CutEdge;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Cell;
 
@@ -28,10 +27,21 @@ use crate::mesh::Cell;
 struct Vertex {
     x: [f64; 3],
     q: f64,
-    cut: usize,
+    /// Unit vector along the cut edge from its `-` end to its `+` end.
+    across: [f64; 3],
 }
 
 pub(super) fn loads(view: &LoadView, out: &mut [[f64; 3]]) {
+    gauss_loads(view, |_, f, tri, bary| distribute(view.surface, tri, bary, f, out));
+}
+
+/// Calls `sink(x, f, triangle, bary)` for every Gauss point `x` of the reconstructed interface
+/// with its force `f` on the structure and the structure triangle and barycentric coordinates of
+/// its projection.
+pub(super) fn gauss_loads(
+    view: &LoadView,
+    mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
+) {
     let mut polygon = Vec::with_capacity(12);
     for cell in &view.mesh.cells {
         let cut_of = cell_cuts(view, cell);
@@ -41,8 +51,8 @@ pub(super) fn loads(view: &LoadView, out: &mut [[f64; 3]]) {
         for (cycle, walked) in cycles(cell, &cut_of) {
             polygon.clear();
             polygon.extend(cycle.iter().map(|&k| vertex(view, k)));
-            orient(view.cuts, &mut polygon, walked);
-            integrate(view, &polygon, out);
+            orient(&mut polygon, walked);
+            integrate(view, &cycle, &polygon, &mut sink);
         }
     }
 }
@@ -136,17 +146,16 @@ fn vertex(view: &LoadView, k: usize) -> Vertex {
     let d = sub(xj, xi);
     let [pi, pj] = view.p_star[k].map(or_zero);
     // The `+` end is the one n_E points to.
-    let q = if dot(cut.normal, d) > 0.0 { pi - pj } else { pj - pi };
-    Vertex { x: add(xi, scale(d, cut.alpha)), q, cut: k }
+    let (q, s) = if dot(cut.normal, d) > 0.0 { (pi - pj, 1.0) } else { (pj - pi, -1.0) };
+    Vertex { x: add(xi, scale(d, cut.alpha)), q, across: scale(d, s / norm(d)) }
 }
 
 /// Orders the vertices of a polygon that did not come from the face walk by angle about their
-/// centroid, then turns the polygon so that its normal agrees with the mean `n_E`.
-fn orient(cuts: &[CutEdge], poly: &mut [Vertex], walked: bool) {
-    let mut n_mean = [0.0; 3];
-    for v in poly.iter() {
-        n_mean = add(n_mean, cuts[v.cut].normal);
-    }
+/// centroid, then turns the polygon to face from the `-` ends of its cut edges to their `+` ends
+/// (the sum of the unit edge vectors: unlike the mean `n_E`, never misleading where the polygon
+/// spans a sharp edge of the surface).
+fn orient(poly: &mut [Vertex], walked: bool) {
+    let n_mean = poly.iter().fold([0.0; 3], |s, v| add(s, v.across));
     if !walked {
         let c = centroid(poly);
         // Angle about the centroid in the plane normal to the mean surface normal.
@@ -188,9 +197,14 @@ const GAUSS: [[f64; 3]; 3] = [
     [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
 ];
 
-/// Integrates `q n̂` over the triangles of an oriented polygon and distributes it.
-fn integrate(view: &LoadView, poly: &[Vertex], out: &mut [[f64; 3]]) {
-    let mut candidates: Vec<u32> = poly.iter().map(|v| view.cuts[v.cut].triangle).collect();
+/// Integrates `q n̂` over the triangles of an oriented polygon into `sink`.
+fn integrate(
+    view: &LoadView,
+    cycle: &[usize],
+    poly: &[Vertex],
+    sink: &mut impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
+) {
+    let mut candidates: Vec<u32> = cycle.iter().map(|&k| view.cuts[k].triangle).collect();
     candidates.sort_unstable();
     candidates.dedup();
     let corners: Vec<[[f64; 3]; 3]> =
@@ -201,7 +215,7 @@ fn integrate(view: &LoadView, poly: &[Vertex], out: &mut [[f64; 3]]) {
             let x = add(add(scale(a.0, g[0]), scale(b.0, g[1])), scale(c.0, g[2]));
             let q = g[0] * a.1 + g[1] * b.1 + g[2] * c.1;
             let (k, bary) = nearest(&corners, x);
-            distribute(view.surface, candidates[k], bary, scale(area, q / 3.0), out);
+            sink(x, scale(area, q / 3.0), candidates[k], bary);
         }
     };
     let p = |v: &Vertex| (v.x, v.q);
