@@ -3,13 +3,13 @@
 //! polygons of two cells sharing a face share its segment and the interface is watertight).
 //!
 //! Polygons are ordered by walking the cell's faces: a face with two cut edges gives the segment
-//! between their points; a face with four (an ambiguous hex face) pairs them in the face's cycle
-//! order starting from its first edge (one fixed rule, the same seen from both cells); the
-//! segments are chained into cycles. A cell whose faces do not close into cycles (odd counts: the
-//! rim of an open surface, a cell holding a surface corner) orders its points by angle about their
-//! centroid in the plane normal to the mean `n_E`. Each polygon is oriented along the surface
-//! normals `n_E` of its points and cut into triangles (one, or a fan about its centroid), each with
-//! its own normal.
+//! between their points; a face with four (an ambiguous quad face, its diagonal corners on the
+//! same side) pairs the two cut edges at its lowest-numbered node and the other two (one fixed
+//! rule on global numbers, so both cells of the face agree); the segments are chained into
+//! cycles. A cell whose faces do not close into cycles (odd counts: the rim of an open surface, a
+//! cell holding a surface corner) orders its points by angle about their centroid. Each polygon
+//! faces from the `-` to the `+` ends of its cut edges and is cut into triangles (one, or a fan
+//! about its centroid), each with its own normal.
 //!
 //! On each triangle the load density is `q n̂`, `q = p*_- - p*_+` interpolated linearly from the
 //! points (`+` the end of the cut edge on the side `n_E` points to), integrated with the
@@ -102,7 +102,12 @@ fn cycles(cell: &Cell, cut_of: &[Option<usize>; 12]) -> Vec<(Vec<usize>, bool)> 
         if m % 2 == 1 {
             closed = false;
         }
-
+        if m == 4 {
+            // Ambiguous face: edge k joins face nodes k and k + 1; cut off the lowest-numbered
+            // node, i.e. pair its edges k0 - 1 and k0.
+            let k0 = (0..4).min_by_key(|&k| cell.nodes[face[k]]).expect("four nodes");
+            on_face = [0, 1, 2, 3].map(|r| on_face[(k0 + 3 + r) % 4]);
+        }
         for pair in on_face[..m - m % 2].chunks(2) {
             for (a, b) in [(pair[0], pair[1]), (pair[1], pair[0])] {
                 if degree[a] < 2 {

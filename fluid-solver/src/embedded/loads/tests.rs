@@ -400,6 +400,53 @@ fn constant_pressure_moment_on_closed_surfaces() {
     }
 }
 
+/// An ambiguous hex face: a thin ellipsoid along the diagonal of the face z = 0 of unit hexes
+/// holds two opposite corners of it and not the other two, so the face has four cut edges and the
+/// cells above and below must pair them alike. A constant pressure gives no net force.
+#[test]
+fn ambiguous_hex_face_is_closed_alike_from_both_cells() {
+    let mut raw = BoxSpec::uniform([-1.0, -1.0, -1.0], [2.0, 2.0, 1.0], [3, 3, 2], BoxCells::Hex)
+        .raw()
+        .unwrap();
+    // The cell above the face numbered a quarter turn about z from the one below, so that a rule
+    // reading the face from its local first node would pair its edges differently in the two.
+    let above = raw
+        .cells
+        .iter()
+        .position(|c| {
+            let m = c.nodes().iter().fold([0.0; 3], |s, &v| add(s, raw.coords[v as usize]));
+            norm(sub(scale(m, 0.125), [0.5, 0.5, 0.5])) < 1e-12
+        })
+        .unwrap();
+    let h = raw.cells[above].nodes;
+    raw.cells[above].nodes[..8].copy_from_slice(&[h[1], h[2], h[3], h[0], h[5], h[6], h[7], h[4]]);
+    let mesh = Mesh::build(raw).unwrap();
+    let (x, t) = icosphere(3, 1.0);
+    let axes = [[0.9 / 2f64.sqrt(), -0.9 / 2f64.sqrt(), 0.0], [0.2, 0.2, 0.0], [0.0, 0.0, 0.3]];
+    let x = x
+        .into_iter()
+        .map(|p| {
+            let mut y = [0.5, 0.5, 0.013];
+            for (k, a) in axes.iter().enumerate() {
+                y = add(y, scale(*a, p[k]));
+            }
+            y
+        })
+        .collect();
+    let t: Vec<[u32; 4]> = t.iter().map(|t| [t[0], t[1], t[2], u32::MAX]).collect();
+    let s = surface(x, &t);
+    let cuts = brute_force_cuts(&mesh, &s, 0.0);
+    let corner = (0..mesh.n_nodes()).find(|&k| mesh.coords[k] == [-1.0; 3]).unwrap();
+    let outer = flood_fill(&mesh, &cuts, corner);
+    let mut inner: Vec<[f64; 3]> =
+        (0..mesh.n_nodes()).filter(|&k| !outer[k]).map(|k| mesh.coords[k]).collect();
+    inner.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    assert_eq!(inner, vec![[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]], "two opposite corners inside");
+    let p_star = prescribe(&mesh, &cuts, &outer, |_| 1.0);
+    let f = load(LoadAlgorithm::Reconstructed, &mesh, &s, &cuts, &outer, &p_star, [0.0; 3]);
+    assert!(norm(f.force) < 1e-14, "{:?}", f.force);
+}
+
 /// Wrong buffer lengths and cut edges outside the mesh are named errors.
 #[test]
 fn bad_inputs_are_named() {
