@@ -12,11 +12,15 @@ pub mod adjacency;
 pub mod bvh;
 pub mod generate;
 pub mod intersect;
+pub mod loads;
 pub mod motion;
 pub mod predicates;
 pub mod read;
+pub mod riemann_fs;
 pub mod status;
 pub mod surface;
+#[cfg(test)]
+pub(crate) mod test_cuts;
 #[cfg(test)]
 mod tests;
 

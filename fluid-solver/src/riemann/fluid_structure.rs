@@ -8,7 +8,7 @@
 //! star velocity is zero in the wall frame).
 
 use super::wave_curve::Side;
-use super::{solve_increasing, RiemannError};
+use super::{solve_increasing, Clipped, PressureCutoff, RiemannError};
 use crate::eos::Eos;
 
 /// Fluid state at the wall: density `ρ*` and pressure `p*`; its velocity is the wall's.
@@ -28,8 +28,30 @@ pub fn fluid_structure(
     p: f64,
     w_n: f64,
 ) -> Result<WallState, RiemannError> {
+    fluid_structure_with_cutoff(eos, rho, u_n, p, w_n, PressureCutoff::OFF).map(|c| c.state)
+}
+
+/// [`fluid_structure`] with the cavitation cut-off: when `f(p_cut) >= u_n - w_n` the exact `p*`
+/// lies below `p_cut` (or the wall leaves a void behind), and the wall state is
+/// `(ρ(p_cut), p_cut)` on the node's wave curve (the isentrope for the rarefaction a receding
+/// wall makes), flagged as clipped. Otherwise the exact solution, bitwise as without the cut-off.
+#[inline]
+pub fn fluid_structure_with_cutoff(
+    eos: &Eos,
+    rho: f64,
+    u_n: f64,
+    p: f64,
+    w_n: f64,
+    cut: PressureCutoff,
+) -> Result<Clipped<WallState>, RiemannError> {
     let side = Side::new(eos, rho, u_n, p);
     let rel = u_n - w_n;
+    if let Some(p_cut) = cut.active_above(side.p_floor()) {
+        if side.f(p_cut).0 >= rel {
+            let state = WallState { rho: side.density_behind(p_cut), p: p_cut };
+            return Ok(Clipped { state, clipped: true });
+        }
+    }
     let guess = p + rho * side.c * rel;
     let p_star = solve_increasing(
         |q| {
@@ -39,5 +61,5 @@ pub fn fluid_structure(
         side.p_floor(),
         guess,
     )?;
-    Ok(WallState { rho: side.density_behind(p_star), p: p_star })
+    Ok(Clipped { state: WallState { rho: side.density_behind(p_star), p: p_star }, clipped: false })
 }

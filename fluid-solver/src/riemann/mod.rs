@@ -12,7 +12,7 @@ mod sample;
 pub mod simple_wave;
 mod wave_curve;
 
-pub use fluid_structure::{fluid_structure, WallState};
+pub use fluid_structure::{fluid_structure, fluid_structure_with_cutoff, WallState};
 pub use sample::{RiemannSolution, Sample};
 
 use crate::eos::Eos;
@@ -59,13 +59,83 @@ pub enum RiemannError {
     NoConvergence { p: f64, residual: f64 },
 }
 
+/// Vapour pressure of water at 20 °C (Pa): the default cavitation cut-off of a liquid.
+pub const WATER_VAPOUR_PRESSURE_20C: f64 = 2339.0;
+
+/// The cavitation cut-off of DESIGN §5.1: star pressures below `p_cut` are set to `p_cut`, the
+/// density then taken on the same wave curve at `p_cut` (the isentrope through the node state for
+/// a rarefaction). A liquid cannot sustain the tension an inviscid Riemann solver returns behind a
+/// receding wall (1 atm Tait water reaches `p* < 0` at 0.07 m/s of wall speed); the cut-off models
+/// the vapour cavity as a region held at `p_cut`, which the thesis' model does not carry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PressureCutoff {
+    /// The minimum star pressure; `-∞` is off.
+    pub p_cut: f64,
+}
+
+impl PressureCutoff {
+    /// No cut-off: tension is returned as computed, a void as [`RiemannError::Vacuum`].
+    pub const OFF: PressureCutoff = PressureCutoff { p_cut: f64::NEG_INFINITY };
+
+    /// The default for a material: liquids (Tait, and stiffened gas with `p_c > 0`) the vapour
+    /// pressure of water at 20 °C, 2339 Pa; perfect gases off (a gas at `p = 0` has `ρ = 0`, a
+    /// true vacuum, which stays an error).
+    pub fn default_for(eos: &Eos) -> PressureCutoff {
+        match *eos {
+            Eos::Tait { .. } => PressureCutoff { p_cut: WATER_VAPOUR_PRESSURE_20C },
+            Eos::StiffenedGas { p_c, .. } if p_c > 0.0 => {
+                PressureCutoff { p_cut: WATER_VAPOUR_PRESSURE_20C }
+            }
+            _ => PressureCutoff::OFF,
+        }
+    }
+
+    /// The cut-off pressure if it can act: strictly above the lowest pressure `p_floor` the wave
+    /// curve reaches (at or below it the cut-off would hold a void, `ρ = 0`).
+    #[inline]
+    fn active_above(&self, p_floor: f64) -> Option<f64> {
+        (self.p_cut > p_floor).then_some(self.p_cut)
+    }
+}
+
+/// A star state and whether the cavitation cut-off clipped its pressure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clipped<T> {
+    pub state: T,
+    /// True when the exact star pressure lay below `p_cut` (or the problem opened a void) and
+    /// `p_cut` was used instead.
+    pub clipped: bool,
+}
+
 /// Solves the Riemann problem between `l` (EOS `eos_l`) and `r` (EOS `eos_r`) for its star state.
 /// With `eos_l == eos_r` this is the single-material problem P1; otherwise the two-phase P2.
 pub fn solve(eos_l: &Eos, l: State1d, eos_r: &Eos, r: State1d) -> Result<StarState, RiemannError> {
+    solve_with_cutoff(eos_l, l, eos_r, r, PressureCutoff::OFF).map(|c| c.state)
+}
+
+/// [`solve`] with the cavitation cut-off `cut` (the larger of the two materials' cut-offs is the
+/// caller's choice): if the star-pressure function is already non-negative at `p_cut`, the root
+/// lies below it (or there is none: a void) and the star state is taken at `p_cut` on both wave
+/// curves, its velocity the mean of the two curves' velocities there; otherwise the problem is
+/// solved exactly as without the cut-off.
+pub fn solve_with_cutoff(
+    eos_l: &Eos,
+    l: State1d,
+    eos_r: &Eos,
+    r: State1d,
+    cut: PressureCutoff,
+) -> Result<Clipped<StarState>, RiemannError> {
     let sl = Side::new(eos_l, l.rho, l.u, l.p);
     let sr = Side::new(eos_r, r.rho, r.u, r.p);
+    if let Some(p_cut) = cut.active_above(sl.p_floor().max(sr.p_floor())) {
+        let (fl, _) = sl.f(p_cut);
+        let (fr, _) = sr.f(p_cut);
+        if fl + fr + sr.u - sl.u >= 0.0 {
+            return Ok(Clipped { state: star_from_pressure(&sl, &sr, p_cut), clipped: true });
+        }
+    }
     let p = star_pressure(&sl, &sr)?;
-    Ok(star_from_pressure(&sl, &sr, p))
+    Ok(Clipped { state: star_from_pressure(&sl, &sr, p), clipped: false })
 }
 
 #[inline]

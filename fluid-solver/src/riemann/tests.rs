@@ -313,6 +313,95 @@ fn receding_wall_can_open_a_vacuum() {
     ));
 }
 
+/// DESIGN §5.1 cavitation: water at 1 atm (Tait, and stiffened gas) behind a wall receding at
+/// 1, 10 and 100 m/s. Without the cut-off the exact solver returns tension (`p* < 0`, about
+/// `p0 - ρc w`); with it `p* = p_cut`, `ρ*` on the node's isentrope at `p_cut`, and the clip is
+/// flagged. A wall at rest or advancing is not clipped and keeps the exact star state bitwise.
+#[test]
+fn cavitation_cutoff_holds_receding_water_at_the_vapour_pressure() {
+    let tait = tait_water();
+    let sg = Eos::StiffenedGas { gamma: 7.15, p_c: 2.89e8 };
+    for eos in [tait, sg] {
+        let cut = PressureCutoff::default_for(&eos);
+        assert_eq!(cut.p_cut, WATER_VAPOUR_PRESSURE_20C);
+        let (rho, p) = (1000.0, if eos.is_barotropic() { tait.tait_pressure(1000.0) } else { 1e5 });
+        let z = rho * eos.sound_speed(rho, p);
+        for w in [1.0, 10.0, 100.0] {
+            let exact = fluid_structure(&eos, rho, 0.0, p, w).unwrap();
+            // Acoustic estimate p - ρcw, within the nonlinear correction of a strong rarefaction.
+            assert!(exact.p < 0.0 && close(exact.p, p - z * w, 0.2), "{eos:?} {w}: {}", exact.p);
+            let c = fluid_structure_with_cutoff(&eos, rho, 0.0, p, w, cut).unwrap();
+            assert!(c.clipped && c.state.p == cut.p_cut, "{eos:?} {w}: {c:?}");
+            let (g, pi) = eos.stiffness();
+            let rho_cut = rho * ((cut.p_cut + pi) / (p + pi)).powf(1.0 / g);
+            assert!(close(c.state.rho, rho_cut, 1e-13) && c.state.rho < rho);
+            if eos.is_barotropic() {
+                assert!(close(eos.tait_pressure(c.state.rho), cut.p_cut, 1e-6));
+            }
+        }
+        for w in [0.0, -10.0, 0.05] {
+            let exact = fluid_structure(&eos, rho, 0.0, p, w).unwrap();
+            let c = fluid_structure_with_cutoff(&eos, rho, 0.0, p, w, cut).unwrap();
+            assert!(!c.clipped && c.state == exact, "{eos:?} {w}");
+        }
+    }
+    // DESIGN §5.1: 1 atm Tait water, 0.1 m/s of recession, p* about -4.4e4 Pa.
+    let p01 = fluid_structure(&tait, 1000.0, 0.0, tait.tait_pressure(1000.0), 0.1).unwrap().p;
+    assert!((p01 + 4.4e4).abs() < 0.1e4, "{p01}");
+}
+
+/// A receding wall faster than the escape speed opens a void: an error without the cut-off, the
+/// cut-off pressure with it (stiffened water, whose floor -p_c lies below p_cut).
+#[test]
+fn cavitation_cutoff_replaces_a_void_and_gases_keep_the_error() {
+    let escape = 2.0 * WATER_SG.sound_speed(1000.0, 1e5) / (7.15 - 1.0);
+    let w = 1.2 * escape;
+    assert!(matches!(
+        fluid_structure(&WATER_SG, 1000.0, 0.0, 1e5, w),
+        Err(RiemannError::Vacuum { .. })
+    ));
+    let cut = PressureCutoff::default_for(&WATER_SG);
+    let c = fluid_structure_with_cutoff(&WATER_SG, 1000.0, 0.0, 1e5, w, cut).unwrap();
+    assert!(c.clipped && c.state.p == WATER_VAPOUR_PRESSURE_20C && c.state.rho > 0.0);
+    // A perfect gas: off by default; a cut-off at the floor p = 0 would hold a void, so it does
+    // not act and the vacuum stays an error.
+    assert_eq!(PressureCutoff::default_for(&AIR), PressureCutoff::OFF);
+    let c = AIR.sound_speed(1.3, 1e5);
+    let zero = PressureCutoff { p_cut: 0.0 };
+    assert!(matches!(
+        fluid_structure_with_cutoff(&AIR, 1.3, 0.0, 1e5, 5.1 * c, zero),
+        Err(RiemannError::Vacuum { .. })
+    ));
+    // A gas with a positive cut-off clips to it like a liquid.
+    let c1 =
+        fluid_structure_with_cutoff(&AIR, 1.3, 0.0, 1e5, 5.1 * c, PressureCutoff { p_cut: 10.0 })
+            .unwrap();
+    assert!(c1.clipped && c1.state.p == 10.0);
+}
+
+/// The two-phase solver with the cut-off: water pulled apart from water (and from air) is held at
+/// `p_cut` on both wave curves; unclipped problems equal [`solve`] bitwise.
+#[test]
+fn two_phase_cutoff() {
+    let tait = tait_water();
+    let cut = PressureCutoff::default_for(&tait);
+    let p = tait.tait_pressure(1000.0);
+    // Water pulled apart at 20 m/s; water pulled from air that leaves at 1000 m/s (the air
+    // rarefies to p_cut).
+    for (eos_r, r) in [(tait, st(1000.0, 10.0, p)), (AIR, st(1.2, 1000.0, 1e5))] {
+        let l = st(1000.0, -10.0, p);
+        let c = solve_with_cutoff(&tait, l, &eos_r, r, cut).unwrap();
+        assert!(c.clipped && c.state.p == cut.p_cut, "{c:?}");
+        assert!(close(tait.tait_pressure(c.state.rho_l), cut.p_cut, 1e-6));
+        let (g, pi) = eos_r.stiffness();
+        assert!(close(c.state.rho_r, r.rho * ((cut.p_cut + pi) / (r.p + pi)).powf(1.0 / g), 1e-13));
+        let calm = solve_with_cutoff(&tait, st(1000.0, 1.0, p), &eos_r, st(r.rho, -1.0, r.p), cut)
+            .unwrap();
+        let exact = solve(&tait, st(1000.0, 1.0, p), &eos_r, st(r.rho, -1.0, r.p)).unwrap();
+        assert!(!calm.clipped && calm.state == exact);
+    }
+}
+
 fn gas_state() -> impl Strategy<Value = State1d> {
     (-3.0f64..3.0, -3.0f64..3.0, -6.0f64..6.0)
         .prop_map(|(lr, u, lp)| st(10f64.powf(lr), u * 100.0, 10f64.powf(lp)))
