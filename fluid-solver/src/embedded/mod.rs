@@ -10,6 +10,7 @@
 
 pub mod adjacency;
 pub mod bvh;
+pub mod fill;
 pub mod generate;
 pub mod intersect;
 pub mod loads;
@@ -23,6 +24,7 @@ pub mod surface;
 pub(crate) mod test_cuts;
 #[cfg(test)]
 mod tests;
+pub mod tracker;
 
 pub use surface::Surface;
 

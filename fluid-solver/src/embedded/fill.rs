@@ -1,0 +1,157 @@
+//! States for the nodes that change side or become active in a step (thesis §4.4, DESIGN §5
+//! "swept nodes"): a node that becomes an active fluid node takes the average primitive state of
+//! its neighbours that were active on its new side before the step and still are, through edges
+//! the surface does not cut now; never across the surface (and, with several fluids, never
+//! across materials: `same_fluid` decides). A node with no such neighbour takes the average over
+//! its same-side neighbours of their own source averages (sources two edges away); a node with
+//! none within two edges is an error: the surface moved too far in one step.
+
+use super::adjacency::NodeEdges;
+use super::status::{NodeSides, NodeStatus, SideChange};
+use crate::mesh::Mesh;
+
+/// A newly active node that no neighbour could fill, named.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("node {node} at {position:?} became an active fluid node on side {side}, but no active node of that side lies within two edges of it: the surface moved more than one cell in a step (thesis §4.4), or the side is a pocket the grid does not resolve")]
+pub struct FillError {
+    pub node: u32,
+    pub position: [f64; 3],
+    pub side: u32,
+}
+
+/// The primitive states of the nodes of `changes` that are active now: `(node, [ρ, u, v, w, p])`,
+/// ascending. `was_active` is each node's status before the step, `cut` the new per-edge cut
+/// mask, `prim` the states before the step, `same_fluid(i, j)` whether two nodes hold one fluid.
+pub fn fill_changed(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    changes: &[SideChange],
+    sides: &NodeSides,
+    was_active: &[bool],
+    cut: &[bool],
+    prim: &[[f64; 5]],
+    same_fluid: impl Fn(usize, usize) -> bool,
+) -> Result<Vec<(u32, [f64; 5])>, FillError> {
+    let n = mesh.n_nodes();
+    let wanted: Vec<u32> =
+        changes.iter().filter(|c| c.new_status == NodeStatus::Active).map(|c| c.node).collect();
+    // A source keeps its state through the step: active before and after, on the same side.
+    let mut changed = vec![false; n];
+    for c in changes {
+        changed[c.node as usize] = true;
+    }
+    let is_source =
+        |j: usize| was_active[j] && !changed[j] && sides.status[j] == NodeStatus::Active;
+    let mut filled: Vec<Option<[f64; 5]>> = vec![None; wanted.len()];
+    let average = |i: usize, ring: &dyn Fn(usize) -> Option<[f64; 5]>| -> Option<[f64; 5]> {
+        let mut sum = [0.0; 5];
+        let mut count = 0usize;
+        for (j, e) in adjacency.neighbours(mesh, i) {
+            if cut[e as usize] || sides.side[j] != sides.side[i] || !same_fluid(i, j) {
+                continue;
+            }
+            if let Some(w) = ring(j) {
+                for c in 0..5 {
+                    sum[c] += w[c];
+                }
+                count += 1;
+            }
+        }
+        (count > 0).then(|| sum.map(|s| s / count as f64))
+    };
+    // Second ring for the rest: sources two edges away through uncut same-side edges.
+    for (k, &i) in wanted.iter().enumerate() {
+        let i = i as usize;
+        filled[k] = average(i, &|j| is_source(j).then(|| prim[j]));
+        if filled[k].is_some() {
+            continue;
+        }
+        let ring2 = |j: usize| average(j, &|m: usize| (m != i && is_source(m)).then(|| prim[m]));
+        filled[k] = average(i, &ring2);
+        if filled[k].is_none() {
+            return Err(FillError {
+                node: i as u32,
+                position: mesh.coords[i],
+                side: sides.side[i],
+            });
+        }
+    }
+    Ok(wanted.into_iter().zip(filled).map(|(i, w)| (i, w.expect("filled above"))).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::embedded::generate::plate;
+    use crate::embedded::tracker::{Seed, Tracker};
+    use crate::embedded::Surface;
+    use crate::mesh::boxmesh::{BoxCells, BoxSpec};
+    use interface_protocol::case::Tracking;
+
+    /// A wall closing a tube moves 0.6 cells towards the body side: the nodes it uncovers become
+    /// active and take the state of their fluid neighbours (uniform here, so exactly it), and a
+    /// wall that jumps three cells leaves nodes no neighbour can fill, named in the error.
+    #[test]
+    fn uncovered_nodes_take_their_neighbours_state() {
+        let spec = BoxSpec::uniform([0.0; 3], [1.0, 0.2, 0.2], [10, 2, 2], BoxCells::Tet);
+        let mesh = Mesh::build(spec.raw().unwrap()).unwrap();
+        let wall = |x: f64| plate([x, -0.1, -0.1], [0.0, 0.4, 0.0], [0.0, 0.0, 0.4], [2, 2]);
+        let s0 = wall(0.55);
+        let surface = Surface::new(&s0.elements, s0.x.clone(), 0).unwrap();
+        let seeds =
+            [Seed { point: [0.0; 3], fluid: true }, Seed { point: [1.0, 0.0, 0.0], fluid: false }];
+        let mut tracker = Tracker::new(&mesh, surface, Tracking::Collision, &seeds).unwrap();
+        let was_active = tracker.active.clone();
+        let n_active = was_active.iter().filter(|a| **a).count();
+        let w = [1.2, 3.0, 0.0, 0.0, 1e5];
+        let prim: Vec<[f64; 5]> =
+            (0..mesh.n_nodes()).map(|i| if was_active[i] { w } else { [f64::NAN; 5] }).collect();
+        let s1 = wall(0.61);
+        let v = vec![[1.0, 0.0, 0.0]; s1.x.len()];
+        let changes = tracker.advance(&mesh, 0.06, &s1.x, &v).unwrap();
+        let gained: Vec<u32> =
+            changes.iter().filter(|c| c.new_status == NodeStatus::Active).map(|c| c.node).collect();
+        assert_eq!(tracker.active.iter().filter(|a| **a).count(), n_active + gained.len());
+        assert!(
+            !gained.is_empty()
+                && gained.iter().all(|&i| (mesh.coords[i as usize][0] - 0.6).abs() < 1e-12)
+        );
+        let cut = tracker.cuts.cut_mask(mesh.n_edges());
+        let filled = fill_changed(
+            &mesh,
+            &tracker.adjacency,
+            &changes,
+            &tracker.sides,
+            &was_active,
+            &cut,
+            &prim,
+            |_, _| true,
+        )
+        .unwrap();
+        assert_eq!(filled.iter().map(|f| f.0).collect::<Vec<_>>(), gained);
+        assert!(filled.iter().all(|f| f.1 == w), "{filled:?}");
+
+        let mut tracker = Tracker::new(
+            &mesh,
+            Surface::new(&s0.elements, s0.x.clone(), 0).unwrap(),
+            Tracking::Collision,
+            &seeds,
+        )
+        .unwrap();
+        let s2 = wall(0.95);
+        let changes = tracker.advance(&mesh, 0.4, &s2.x, &v).unwrap();
+        let cut = tracker.cuts.cut_mask(mesh.n_edges());
+        let e = fill_changed(
+            &mesh,
+            &tracker.adjacency,
+            &changes,
+            &tracker.sides,
+            &was_active,
+            &cut,
+            &prim,
+            |_, _| true,
+        )
+        .unwrap_err();
+        assert!(mesh.coords[e.node as usize][0] > 0.75, "{e}");
+    }
+}
