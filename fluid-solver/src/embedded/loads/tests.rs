@@ -447,6 +447,35 @@ fn ambiguous_hex_face_is_closed_alike_from_both_cells() {
     assert!(norm(f.force) < 1e-14, "{:?}", f.force);
 }
 
+/// A shell wet on both sides: a tilted plane across the whole box (perturbed tets) with 2e5 Pa
+/// below and 1e5 Pa above. Both sides summed, the resultant is `Δp` times the area vector of the
+/// plane inside the box, `4 Δp (n_x/n_z, n_y/n_z, 1)`. Alg. 5.3's reconstruction ends on the box
+/// faces at points of the exact plane, so its resultant is exact to round-off; Alg. 5.4's
+/// facets give the `z` part exactly (the bottom face's dual areas) and the rest to O(h).
+#[test]
+fn shell_wet_on_both_sides_sums_both() {
+    let mut raw = BoxSpec::uniform([-1.0; 3], [1.0; 3], [8; 3], BoxCells::Tet).raw().unwrap();
+    perturb(&mut raw, 0.2, 11);
+    let mesh = Mesh::build(raw).unwrap();
+    let n = [0.1, -0.05, 1.0];
+    let z = |x: f64, y: f64| 0.013 - (n[0] * x + n[1] * y) / n[2];
+    let x =
+        [[-3.0, -3.0], [3.0, -3.0], [3.0, 3.0], [-3.0, 3.0]].map(|p| [p[0], p[1], z(p[0], p[1])]);
+    let s = surface(x.to_vec(), &[[0, 1, 2, 3]]);
+    let cuts = brute_force_cuts(&mesh, &s, 0.0);
+    let below: Vec<bool> = mesh.coords.iter().map(|x| x[2] < z(x[0], x[1])).collect();
+    let p_star: Vec<[f64; 2]> = cuts
+        .iter()
+        .map(|c| mesh.edges[c.edge as usize].map(|v| if below[v as usize] { 2e5 } else { 1e5 }))
+        .collect();
+    let exact = [4e5 * n[0] / n[2], 4e5 * n[1] / n[2], 4e5];
+    let f3 = load(LoadAlgorithm::Reconstructed, &mesh, &s, &cuts, &below, &p_star, [0.0; 3]);
+    assert!(norm(sub(f3.force, exact)) < 1e-9 * 4e5, "{:?}", f3.force);
+    let f4 = load(LoadAlgorithm::Facets, &mesh, &s, &cuts, &below, &p_star, [0.0; 3]).force;
+    assert!((f4[2] - exact[2]).abs() < 1e-9 * 4e5, "{f4:?}");
+    assert!(norm(sub(f4, exact)) < 0.1 * 4e5, "{f4:?}");
+}
+
 /// Wrong buffer lengths and cut edges outside the mesh are named errors.
 #[test]
 fn bad_inputs_are_named() {
