@@ -152,7 +152,19 @@ fn ribbon_error(algorithm: LoadAlgorithm, n: usize, shape: BoxCells, jitter: f64
     norm(sub(f, [exact, exact, 0.0])) / (exact.abs() * 2f64.sqrt())
 }
 
-fn ribbon_study(algorithm: LoadAlgorithm, ns: &[usize], shape: BoxCells, jitter: f64) -> f64 {
+/// The ribbon errors on meshes `ns`, printed with their fitted order and compared with the
+/// committed table `ribbon_errors.json` (to 1%: the table holds four digits).
+fn ribbon_study(algorithm: LoadAlgorithm, table: &str, shape: BoxCells, jitter: f64) -> f64 {
+    let reference: serde_json::Value =
+        serde_json::from_str(include_str!("ribbon_errors.json")).unwrap();
+    let column = |key: &str| -> Vec<f64> {
+        reference[table][key].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+    };
+    let ns: Vec<usize> = column("n").iter().map(|&n| n as usize).collect();
+    let key = match algorithm {
+        LoadAlgorithm::Facets => "facets",
+        LoadAlgorithm::Reconstructed => "reconstructed",
+    };
     let h: Vec<f64> = ns.iter().map(|&n| 4.0 / n as f64).collect();
     let e: Vec<f64> = ns.iter().map(|&n| ribbon_error(algorithm, n, shape, jitter)).collect();
     let order = fitted_order(&h, &e);
@@ -160,27 +172,31 @@ fn ribbon_study(algorithm: LoadAlgorithm, ns: &[usize], shape: BoxCells, jitter:
         "{algorithm:?} {shape:?} jitter {jitter}: n {ns:?} errors {} order {order:.2}",
         sci(&e)
     );
+    for (got, want) in e.iter().zip(column(key)) {
+        assert!((got - want).abs() <= 0.01 * want, "{algorithm:?} {table}: {got:e} vs {want:e}");
+    }
     order
 }
 
 /// Thesis §5.3.4 ideal case: uniform hexes with the ribbon on dual facets (`n ≡ 2 mod 4`
-/// puts x, y = ±1 half-way between nodes): both algorithms second order.
+/// puts x, y = ±1 half-way between nodes): both algorithms second order (measured 2.01 for
+/// Alg. 5.4, 1.98 for Alg. 5.3; the thesis finds 5.4 the more accurate here, as we do).
 #[test]
 fn ribbon_on_dual_facets_is_second_order() {
-    let ns = [6, 10, 14, 18, 22];
     for algorithm in [LoadAlgorithm::Facets, LoadAlgorithm::Reconstructed] {
-        let order = ribbon_study(algorithm, &ns, BoxCells::Hex, 0.0);
+        let order = ribbon_study(algorithm, "hex_on_dual_facets", BoxCells::Hex, 0.0);
         assert!(order >= 1.8, "{algorithm:?}: order {order}");
     }
 }
 
 /// Thesis §5.3.4 realistic case: arbitrary triangles (tets of a one-cell-thick mesh whose nodes
-/// move by 20% of the local edge length): Alg. 5.3 second order, Alg. 5.4 at least first.
+/// move by 20% of the local edge length): Alg. 5.3 second order (measured 2.86), Alg. 5.4 at
+/// least first (measured 1.46, irregular as in the thesis' Fig. 5.23).
 #[test]
 fn ribbon_on_arbitrary_tets() {
-    let ns = [8, 12, 16, 24, 32];
-    let o3 = ribbon_study(LoadAlgorithm::Reconstructed, &ns, BoxCells::Tet, 0.2);
-    let o4 = ribbon_study(LoadAlgorithm::Facets, &ns, BoxCells::Tet, 0.2);
+    let table = "tet_perturbed_20_percent";
+    let o3 = ribbon_study(LoadAlgorithm::Reconstructed, table, BoxCells::Tet, 0.2);
+    let o4 = ribbon_study(LoadAlgorithm::Facets, table, BoxCells::Tet, 0.2);
     assert!(o3 >= 1.8, "Alg. 5.3: order {o3}");
     assert!(o4 >= 1.0, "Alg. 5.4: order {o4}");
 }
