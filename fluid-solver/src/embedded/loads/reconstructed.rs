@@ -43,7 +43,17 @@ pub(super) fn gauss_loads(
     mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
     let mut polygon = Vec::with_capacity(12);
+    // Only cells with a node at the end of a cut edge can be cut.
+    let mut near = vec![false; view.mesh.n_nodes()];
+    for c in view.cuts {
+        for n in view.mesh.edges[c.edge as usize] {
+            near[n as usize] = true;
+        }
+    }
     for cell in &view.mesh.cells {
+        if !cell.nodes().iter().any(|&n| near[n as usize]) {
+            continue;
+        }
         let cut_of = cell_cuts(view, cell);
         if cut_of.iter().flatten().count() < 3 {
             continue;

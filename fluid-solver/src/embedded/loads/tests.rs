@@ -152,7 +152,19 @@ fn ribbon_error(algorithm: LoadAlgorithm, n: usize, shape: BoxCells, jitter: f64
     norm(sub(f, [exact, exact, 0.0])) / (exact.abs() * 2f64.sqrt())
 }
 
-fn ribbon_study(algorithm: LoadAlgorithm, ns: &[usize], shape: BoxCells, jitter: f64) -> f64 {
+/// The ribbon errors on meshes `ns`, printed with their fitted order and compared with the
+/// committed table `ribbon_errors.json` (to 1%: the table holds four digits).
+fn ribbon_study(algorithm: LoadAlgorithm, table: &str, shape: BoxCells, jitter: f64) -> f64 {
+    let reference: serde_json::Value =
+        serde_json::from_str(include_str!("ribbon_errors.json")).unwrap();
+    let column = |key: &str| -> Vec<f64> {
+        reference[table][key].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect()
+    };
+    let ns: Vec<usize> = column("n").iter().map(|&n| n as usize).collect();
+    let key = match algorithm {
+        LoadAlgorithm::Facets => "facets",
+        LoadAlgorithm::Reconstructed => "reconstructed",
+    };
     let h: Vec<f64> = ns.iter().map(|&n| 4.0 / n as f64).collect();
     let e: Vec<f64> = ns.iter().map(|&n| ribbon_error(algorithm, n, shape, jitter)).collect();
     let order = fitted_order(&h, &e);
@@ -160,27 +172,31 @@ fn ribbon_study(algorithm: LoadAlgorithm, ns: &[usize], shape: BoxCells, jitter:
         "{algorithm:?} {shape:?} jitter {jitter}: n {ns:?} errors {} order {order:.2}",
         sci(&e)
     );
+    for (got, want) in e.iter().zip(column(key)) {
+        assert!((got - want).abs() <= 0.01 * want, "{algorithm:?} {table}: {got:e} vs {want:e}");
+    }
     order
 }
 
 /// Thesis §5.3.4 ideal case: uniform hexes with the ribbon on dual facets (`n ≡ 2 mod 4`
-/// puts x, y = ±1 half-way between nodes): both algorithms second order.
+/// puts x, y = ±1 half-way between nodes): both algorithms second order (measured 2.01 for
+/// Alg. 5.4, 1.98 for Alg. 5.3; the thesis finds 5.4 the more accurate here, as we do).
 #[test]
 fn ribbon_on_dual_facets_is_second_order() {
-    let ns = [6, 10, 14, 18, 22];
     for algorithm in [LoadAlgorithm::Facets, LoadAlgorithm::Reconstructed] {
-        let order = ribbon_study(algorithm, &ns, BoxCells::Hex, 0.0);
+        let order = ribbon_study(algorithm, "hex_on_dual_facets", BoxCells::Hex, 0.0);
         assert!(order >= 1.8, "{algorithm:?}: order {order}");
     }
 }
 
 /// Thesis §5.3.4 realistic case: arbitrary triangles (tets of a one-cell-thick mesh whose nodes
-/// move by 20% of the local edge length): Alg. 5.3 second order, Alg. 5.4 at least first.
+/// move by 20% of the local edge length): Alg. 5.3 second order (measured 2.86), Alg. 5.4 at
+/// least first (measured 1.46, irregular as in the thesis' Fig. 5.23).
 #[test]
 fn ribbon_on_arbitrary_tets() {
-    let ns = [8, 12, 16, 24, 32];
-    let o3 = ribbon_study(LoadAlgorithm::Reconstructed, &ns, BoxCells::Tet, 0.2);
-    let o4 = ribbon_study(LoadAlgorithm::Facets, &ns, BoxCells::Tet, 0.2);
+    let table = "tet_perturbed_20_percent";
+    let o3 = ribbon_study(LoadAlgorithm::Reconstructed, table, BoxCells::Tet, 0.2);
+    let o4 = ribbon_study(LoadAlgorithm::Facets, table, BoxCells::Tet, 0.2);
     assert!(o3 >= 1.8, "Alg. 5.3: order {o3}");
     assert!(o4 >= 1.0, "Alg. 5.4: order {o4}");
 }
@@ -445,6 +461,35 @@ fn ambiguous_hex_face_is_closed_alike_from_both_cells() {
     let p_star = prescribe(&mesh, &cuts, &outer, |_| 1.0);
     let f = load(LoadAlgorithm::Reconstructed, &mesh, &s, &cuts, &outer, &p_star, [0.0; 3]);
     assert!(norm(f.force) < 1e-14, "{:?}", f.force);
+}
+
+/// A shell wet on both sides: a tilted plane across the whole box (perturbed tets) with 2e5 Pa
+/// below and 1e5 Pa above. Both sides summed, the resultant is `Δp` times the area vector of the
+/// plane inside the box, `4 Δp (n_x/n_z, n_y/n_z, 1)`. Alg. 5.3's reconstruction ends on the box
+/// faces at points of the exact plane, so its resultant is exact to round-off; Alg. 5.4's
+/// facets give the `z` part exactly (the bottom face's dual areas) and the rest to O(h).
+#[test]
+fn shell_wet_on_both_sides_sums_both() {
+    let mut raw = BoxSpec::uniform([-1.0; 3], [1.0; 3], [8; 3], BoxCells::Tet).raw().unwrap();
+    perturb(&mut raw, 0.2, 11);
+    let mesh = Mesh::build(raw).unwrap();
+    let n = [0.1, -0.05, 1.0];
+    let z = |x: f64, y: f64| 0.013 - (n[0] * x + n[1] * y) / n[2];
+    let x =
+        [[-3.0, -3.0], [3.0, -3.0], [3.0, 3.0], [-3.0, 3.0]].map(|p| [p[0], p[1], z(p[0], p[1])]);
+    let s = surface(x.to_vec(), &[[0, 1, 2, 3]]);
+    let cuts = brute_force_cuts(&mesh, &s, 0.0);
+    let below: Vec<bool> = mesh.coords.iter().map(|x| x[2] < z(x[0], x[1])).collect();
+    let p_star: Vec<[f64; 2]> = cuts
+        .iter()
+        .map(|c| mesh.edges[c.edge as usize].map(|v| if below[v as usize] { 2e5 } else { 1e5 }))
+        .collect();
+    let exact = [4e5 * n[0] / n[2], 4e5 * n[1] / n[2], 4e5];
+    let f3 = load(LoadAlgorithm::Reconstructed, &mesh, &s, &cuts, &below, &p_star, [0.0; 3]);
+    assert!(norm(sub(f3.force, exact)) < 1e-9 * 4e5, "{:?}", f3.force);
+    let f4 = load(LoadAlgorithm::Facets, &mesh, &s, &cuts, &below, &p_star, [0.0; 3]).force;
+    assert!((f4[2] - exact[2]).abs() < 1e-9 * 4e5, "{f4:?}");
+    assert!(norm(sub(f4, exact)) < 0.1 * 4e5, "{f4:?}");
 }
 
 /// Wrong buffer lengths and cut edges outside the mesh are named errors.
