@@ -10,6 +10,7 @@
 
 pub mod adjacency;
 pub mod bvh;
+pub mod case;
 pub mod fill;
 pub mod generate;
 pub mod intersect;

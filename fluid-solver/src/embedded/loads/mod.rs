@@ -21,19 +21,11 @@ pub mod reconstructed;
 use super::riemann_fs::WallPressures;
 use super::{CutEdge, Surface};
 use crate::mesh::Mesh;
-use serde::Deserialize;
 
-/// The load algorithm of a case (case-file values `"reconstructed"`, `"facets"`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LoadAlgorithm {
-    /// Alg. 5.3: reconstructed interface, second order on arbitrary meshes.
-    #[default]
-    Reconstructed,
-    /// Alg. 5.4: control-volume facets, first order on arbitrary meshes, second on meshes whose
-    /// facets lie on the surface.
-    Facets,
-}
+/// The load algorithm of a case (`[fluid.embedded] loads`): Alg. 5.3 `Reconstructed`, second
+/// order on arbitrary meshes, or Alg. 5.4 `Facets`, first order on arbitrary meshes and second on
+/// meshes whose facets lie on the surface.
+pub use interface_protocol::case::LoadAlgorithm;
 
 /// What the loads read: the mesh, the surface at the load time `t`, the side of every node (any
 /// two values for the two sides of the surface, as the node status gives them), the cut edges
