@@ -1,6 +1,6 @@
-//! The cut edges of the fluid mesh (thesis §4.2-4.3): [`collision`] is Alg. 4.2 (every edge
+//! The cut edges of the fluid mesh (thesis §4.2-4.3): [`collision()`] is Alg. 4.2 (every edge
 //! tested against the triangles near it; open, thin and unresolved surfaces, cracks through phi),
-//! [`projection`] is Alg. 4.1 (sides by projection and flood fill; closed, resolved surfaces).
+//! [`projection()`] is Alg. 4.1 (sides by projection and flood fill; closed, resolved surfaces).
 //! Both return [`Intersections`]: one [`CutEdge`] per cut edge, sorted by edge, with the offsets
 //! of each edge block of [`crate::mesh::EdgeBlocks`], and the occluded nodes.
 //!
