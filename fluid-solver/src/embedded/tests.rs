@@ -434,6 +434,7 @@ fn a_moving_sphere_keeps_statuses_right_through_swept_nodes() {
         changed += changes.len();
         sides = new;
     }
+    println!("moving sphere: {changed} nodes changed side or status in 4 steps");
     assert!(changed > 40, "{changed} nodes changed side");
 }
 

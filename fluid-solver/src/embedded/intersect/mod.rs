@@ -1,6 +1,6 @@
-//! The cut edges of the fluid mesh (thesis §4.2-4.3): [`collision`] is Alg. 4.2 (every edge
+//! The cut edges of the fluid mesh (thesis §4.2-4.3): [`collision()`] is Alg. 4.2 (every edge
 //! tested against the triangles near it; open, thin and unresolved surfaces, cracks through phi),
-//! [`projection`] is Alg. 4.1 (sides by projection and flood fill; closed, resolved surfaces).
+//! [`projection()`] is Alg. 4.1 (sides by projection and flood fill; closed, resolved surfaces).
 //! Both return [`Intersections`]: one [`CutEdge`] per cut edge, sorted by edge, with the offsets
 //! of each edge block of [`crate::mesh::EdgeBlocks`], and the occluded nodes.
 //!
@@ -121,7 +121,7 @@ impl SurfaceAt<'_> {
         self.surface.triangles[t as usize].map(|n| self.x[n as usize])
     }
 
-    /// Interpolated phi at a point of triangle `t`.
+    /// Interpolated phi at a point of triangle `t` (finite: `Surface::new` rejects other phi).
     #[inline]
     fn phi(&self, t: u32, bary: [f64; 3]) -> f64 {
         let p = self.surface.phi[t as usize];
@@ -146,7 +146,7 @@ impl SurfaceAt<'_> {
         self.bvh.for_each_overlap(&lo, &hi, |t| {
             let [a, b, c] = self.corners(t);
             if let Some(h) = segment_triangle(p, q, a, b, c) {
-                if crack_aware && !(self.phi(t, h.bary) >= 0.0) {
+                if crack_aware && self.phi(t, h.bary) < 0.0 {
                     return;
                 }
                 if best.is_none_or(|(al, bt, _)| (h.alpha, t) < (al, bt)) {
@@ -167,7 +167,7 @@ impl SurfaceAt<'_> {
         self.bvh.for_each_overlap(&lo, &hi, |t| {
             let [a, b, c] = self.corners(t);
             let cp = closest_point(p, a, b, c);
-            if crack_aware && !(self.phi(t, cp.bary) >= 0.0) {
+            if crack_aware && self.phi(t, cp.bary) < 0.0 {
                 return;
             }
             if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {

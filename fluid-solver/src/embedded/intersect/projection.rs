@@ -16,7 +16,7 @@
 //!   edge length), projected onto the edge.
 //!
 //! An edge that crosses a thin body twice has both ends on one side and is not cut (thesis
-//! Fig. 4.5, Case II): [`super::collision`] is the algorithm for such bodies. Phi is not used:
+//! Fig. 4.5, Case II): [`super::collision()`] is the algorithm for such bodies. Phi is not used:
 //! a cracked surface is not closed.
 
 use super::{Intersections, SurfaceAt};
