@@ -2,6 +2,9 @@
 //! perfect gas, on a box of tets with a non-uniform state, with 1 and 2 threads; memory per
 //! node (everything the solver holds: mesh, dual, gradient operator, state, scratch and stage
 //! arrays); the split of one step into its passes; and the cost of the edge loop alone per edge.
+//! Then the same for two materials on the same box (`two_material`: water | air at rest, the
+//! edge loop over the gaps between the interface edges with per-node EOS, the two-phase flux on
+//! them, gradients masked at the interface).
 //! A node-step is one full RK2 step (two residuals) of one node (DESIGN §8).
 //!
 //! `--dump-edges FILE` also writes the arrays of the edge loop in the raw format read by the C
@@ -19,7 +22,7 @@ use crate::eos::Eos;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec, FACE_NAMES};
 use crate::mesh::Mesh;
 use crate::semidiscretization::{Numerics, Semidiscretization};
-use crate::state::{State, Workspace};
+use crate::state::{MaterialId, State, Workspace};
 use crate::time::{rk2_step, TimeStepping};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -61,6 +64,19 @@ pub struct BenchReport {
     pub measurements: Vec<Measurement>,
     /// Node-steps per second with 2 threads over 1 thread (when both were measured).
     pub speedup_2_threads: Option<f64>,
+    /// The same box with two fluids.
+    pub two_material: TwoMaterial,
+}
+
+/// The two-material row of the bench.
+#[derive(Debug, Clone, Serialize)]
+pub struct TwoMaterial {
+    pub scheme: &'static str,
+    /// Edges between the two fluids (special edges of the blocks).
+    pub special_edges: usize,
+    pub bytes_per_node: f64,
+    pub bytes_per_node_split: BTreeMap<String, f64>,
+    pub measurements: Vec<Measurement>,
 }
 
 /// Median of a non-empty list.
@@ -109,10 +125,10 @@ pub fn run(
         .iter()
         .map(|f| (f.to_string(), BoundaryCondition::FarField { state: free }))
         .collect();
+    let two_mesh = mesh.clone();
     let semi = Semidiscretization::new(mesh, eos, Numerics::default(), &bcs)?;
-    let initial = State {
-        cons: semi
-            .mesh
+    let initial = State::new(
+        semi.mesh
             .coords
             .iter()
             .map(|x| {
@@ -120,11 +136,82 @@ pub fn run(
                 eos.prim_to_cons(&[1.0 + 0.2 * s, 0.3 + 0.1 * s, 0.1, 0.05 * s, 1.0 + 0.3 * s])
             })
             .collect(),
+    );
+    let single = measure(&semi, &initial, steps, threads, |ws| match dump_edges {
+        Some(path) => dump(path, &semi, ws, gamma),
+        None => Ok(()),
+    })?;
+    let n_nodes = semi.mesh.n_nodes();
+    let rate_with =
+        |t: usize| single.0.iter().find(|m| m.threads == t).map(|m| m.node_steps_per_second);
+    let speedup_2_threads = rate_with(1).zip(rate_with(2)).map(|(one, two)| two / one);
+    let edges = semi.mesh.n_edges();
+    let (cells, edge_blocks) = (semi.mesh.cells.len(), semi.mesh.blocks.len());
+    drop(semi);
+    let two_material = two_material_row(two_mesh, steps, threads)?;
+    Ok(BenchReport {
+        scheme: "RK2 (TVD) + MUSCL (van Albada, LSQ gradients) + Roe, perfect gas, tets",
+        nodes: n_nodes,
+        edges,
+        cells,
+        edge_blocks,
+        steps,
+        mesh_build_seconds,
+        bytes_per_node: single.1.values().sum::<f64>(),
+        bytes_per_node_split: single.1,
+        measurements: single.0,
+        speedup_2_threads,
+        two_material,
+    })
+}
+
+/// The two-material row: the same box, water (stiffened gas, γ 4.4, p_c 6e8) for `x < 0.5` and
+/// air (perfect gas, γ 1.4) beyond, at rest at equal pressure (1e5) between slip walls, so the
+/// state stays exact and every step does the full work (MUSCL on the gaps with each edge's EOS
+/// from the table, the two-phase flux on the interface edges).
+fn two_material_row(mesh: Mesh, steps: usize, threads: &[usize]) -> anyhow::Result<TwoMaterial> {
+    let table = vec![Eos::StiffenedGas { gamma: 4.4, p_c: 6e8 }, Eos::PerfectGas { gamma: 1.4 }];
+    let material: Vec<MaterialId> = mesh.coords.iter().map(|x| u8::from(x[0] >= 0.5)).collect();
+    let walls: Vec<(String, BoundaryCondition)> =
+        FACE_NAMES.iter().map(|f| (f.to_string(), BoundaryCondition::SlipWall)).collect();
+    let semi =
+        Semidiscretization::with_materials(mesh, table, material, Numerics::default(), &walls)?;
+    let rest = [[1000.0, 0.0, 0.0, 0.0, 1e5], [1.2, 0.0, 0.0, 0.0, 1e5]];
+    let state = State {
+        cons: semi
+            .material()
+            .iter()
+            .map(|&m| semi.eos[m as usize].prim_to_cons(&rest[m as usize]))
+            .collect(),
+        material: semi.material().to_vec(),
     };
+    let (measurements, mut split) = measure(&semi, &state, steps, threads, |_| Ok(()))?;
+    let per_node = 1.0 / semi.mesh.n_nodes() as f64;
+    split.insert("special_edges".into(), semi.special_edges().memory_bytes() as f64 * per_node);
+    Ok(TwoMaterial {
+        scheme: "as above, stiffened-gas water | perfect-gas air at rest, two-phase flux at the \
+                 interface",
+        special_edges: semi.special_edges().len(),
+        bytes_per_node: split.values().sum(),
+        bytes_per_node_split: split,
+        measurements,
+    })
+}
+
+/// Times `steps` RK2 steps of `initial` and the passes of one residual for each thread count;
+/// `after` sees the workspace after the first count's passes. Returns the measurements and the
+/// bytes per node of each part the solver holds.
+fn measure(
+    semi: &Semidiscretization,
+    initial: &State,
+    steps: usize,
+    threads: &[usize],
+    mut after: impl FnMut(&Workspace) -> anyhow::Result<()> + Send,
+) -> anyhow::Result<(Vec<Measurement>, BTreeMap<String, f64>)> {
     let n_nodes = semi.mesh.n_nodes();
     let mut measurements = Vec::new();
     let mut split_bytes = BTreeMap::new();
-    let mut dumped = false;
+    let mut first = true;
     for &threads in threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let m = pool.install(|| -> anyhow::Result<Measurement> {
@@ -132,11 +219,11 @@ pub fn run(
             let mut state = initial.clone();
             let stepping = TimeStepping::Global { cfl: 0.9 };
             // Warm up, then time each step.
-            rk2_step(&semi, &mut state, &mut ws, stepping, 1.0)?;
+            rk2_step(semi, &mut state, &mut ws, stepping, 1.0)?;
             let mut per_step = Vec::with_capacity(steps);
             for _ in 0..steps {
                 let start = Instant::now();
-                rk2_step(&semi, &mut state, &mut ws, stepping, 1.0)?;
+                rk2_step(semi, &mut state, &mut ws, stepping, 1.0)?;
                 per_step.push(start.elapsed().as_secs_f64());
             }
             let mean = per_step.iter().sum::<f64>() / steps as f64;
@@ -157,18 +244,17 @@ pub fn run(
             split.insert("gradients".to_string(), t);
             let full = time_median(reps, || Ok(semi.residual_from_primitives(&mut ws)?))?;
             split.insert("fluxes_and_boundary".to_string(), full - split["gradients"]);
-            let edge_loop = time_median(reps, || {
-                semi.edge_residual(&mut ws);
-                Ok(())
-            })?;
-            if let Some(path) = dump_edges.filter(|_| !dumped) {
-                dump(path, &semi, &ws, gamma)?;
-                dumped = true;
+            let edge_loop = time_median(reps, || Ok(semi.edge_residual(&mut ws)?))?;
+            if first {
+                after(&ws)?;
+                first = false;
             }
-            split_bytes.insert("mesh".to_string(), semi.mesh.memory_bytes());
-            split_bytes.insert("gradient_operator".to_string(), semi.gradient.memory_bytes());
-            split_bytes.insert("workspace".to_string(), ws.memory_bytes());
-            split_bytes.insert("state".to_string(), std::mem::size_of_val(&state.cons[..]));
+            let per_node = 1.0 / n_nodes as f64;
+            let mut bytes = |k: &str, b: usize| split_bytes.insert(k.into(), b as f64 * per_node);
+            bytes("mesh", semi.mesh.memory_bytes());
+            bytes("gradient_operator", semi.gradient.memory_bytes());
+            bytes("workspace", ws.memory_bytes());
+            bytes("state", state.memory_bytes());
             let rate = n_nodes as f64 / step;
             Ok(Measurement {
                 threads,
@@ -182,25 +268,7 @@ pub fn run(
         })?;
         measurements.push(m);
     }
-    let bytes: usize = split_bytes.values().sum();
-    let rate_with =
-        |t: usize| measurements.iter().find(|m| m.threads == t).map(|m| m.node_steps_per_second);
-    Ok(BenchReport {
-        scheme: "RK2 (TVD) + MUSCL (van Albada, LSQ gradients) + Roe, perfect gas, tets",
-        nodes: n_nodes,
-        edges: semi.mesh.n_edges(),
-        cells: semi.mesh.cells.len(),
-        edge_blocks: semi.mesh.blocks.len(),
-        steps,
-        mesh_build_seconds,
-        bytes_per_node: bytes as f64 / n_nodes as f64,
-        bytes_per_node_split: split_bytes
-            .into_iter()
-            .map(|(k, v)| (k, v as f64 / n_nodes as f64))
-            .collect(),
-        speedup_2_threads: rate_with(1).zip(rate_with(2)).map(|(one, two)| two / one),
-        measurements,
-    })
+    Ok((measurements, split_bytes))
 }
 
 /// Writes the edge-loop arrays and the edge residual in `ws` (see the module docs).

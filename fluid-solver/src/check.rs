@@ -47,7 +47,21 @@ pub fn check(case: &Case) -> anyhow::Result<Checked> {
         mesh.n_edges(),
         mesh.boundary_names().join(", ")
     )?;
-    writeln!(w, "  eos       {:?}", p.semi.eos)?;
+    match &p.semi.eos[..] {
+        [eos] => writeln!(w, "  eos       {eos:?}")?,
+        table => {
+            let n_of = |m: usize| p.initial.material.iter().filter(|&&k| k as usize == m).count();
+            for (m, eos) in table.iter().enumerate() {
+                let lead = if m == 0 { "fluids" } else { "" };
+                writeln!(
+                    w,
+                    "  {lead:<9} material {m} = `{}` ({} nodes): {eos:?}",
+                    p.fluid_names[m],
+                    n_of(m)
+                )?;
+            }
+        }
+    }
     let (kind, cfl) = match p.stepping {
         TimeStepping::Global { cfl } => ("global", cfl),
         TimeStepping::Local { cfl } => ("local", cfl),

@@ -1,44 +1,72 @@
-//! Initial conditions: a background state, then regions (half-space, box, sphere, cylinder)
-//! applied in order, each node taking the state of the last region containing it. Every state
-//! must be one its EOS admits and every region must hold a node.
+//! Initial conditions: a background state and fluid, then regions (half-space, box, sphere,
+//! cylinder) applied in order, each node taking the state and fluid of the last region containing
+//! it. Every state must be one its own fluid's EOS admits and every region must hold a node.
 
 use crate::eos::Eos;
 use crate::mesh::Mesh;
-use crate::state::State;
+use crate::state::{MaterialId, State};
 use interface_protocol::case::Region;
 
-/// A background primitive state and `(region, primitive state)` pairs, later ones winning.
+/// A primitive state and the material (fluid) it belongs to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fill {
+    pub state: [f64; 5],
+    pub material: MaterialId,
+}
+
+/// A background fill and `(region, fill)` pairs, later ones winning.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InitialCondition {
-    pub background: [f64; 5],
-    pub regions: Vec<(Region, [f64; 5])>,
+    pub background: Fill,
+    pub regions: Vec<(Region, Fill)>,
 }
 
 impl InitialCondition {
-    /// A uniform state.
+    /// A uniform state of material 0.
     pub fn uniform(w: [f64; 5]) -> InitialCondition {
-        InitialCondition { background: w, regions: Vec::new() }
+        InitialCondition { background: Fill { state: w, material: 0 }, regions: Vec::new() }
     }
 
-    /// The primitive state at a point.
-    pub fn at(&self, x: [f64; 3]) -> [f64; 5] {
+    /// One fluid (material 0): the background state, then `(region, state)` pairs.
+    pub fn single(background: [f64; 5], regions: &[(Region, [f64; 5])]) -> InitialCondition {
+        InitialCondition {
+            background: Fill { state: background, material: 0 },
+            regions: regions.iter().map(|&(r, w)| (r, Fill { state: w, material: 0 })).collect(),
+        }
+    }
+
+    /// The fill at a point.
+    pub fn at(&self, x: [f64; 3]) -> Fill {
         self.regions.iter().rev().find(|(r, _)| r.contains(x)).map_or(self.background, |r| r.1)
     }
 
-    /// The conserved state of every node. An error gives the case key (`fluid.initial.<...>`)
-    /// and what is wrong of the first state outside the EOS ([`Eos::check_input`]) or the first
-    /// region that holds no node of the mesh (it would silently do nothing).
-    pub fn state(&self, mesh: &Mesh, eos: &Eos) -> Result<State, (String, String)> {
-        for (k, w) in
+    /// The conserved state and material id of every node, with the EOS table `eos` (indexed by
+    /// material id). An error gives the case key (`fluid.initial.<...>`) and what is wrong of the
+    /// first state outside its own fluid's EOS ([`Eos::check_input`]) or the first region that
+    /// holds no node of the mesh (it would silently do nothing).
+    pub fn state(&self, mesh: &Mesh, eos: &[Eos]) -> Result<State, (String, String)> {
+        for (k, fill) in
             std::iter::once(&self.background).chain(self.regions.iter().map(|r| &r.1)).enumerate()
         {
-            eos.check_input(w).map_err(|e| {
-                let which =
-                    if k == 0 { "state".to_string() } else { format!("regions[{}].state", k - 1) };
-                (
-                    format!("fluid.initial.{which}"),
-                    format!("{w:?} is not a valid state of the EOS: {e}"),
-                )
+            let which = |leaf: &str| {
+                let at = if k == 0 { String::new() } else { format!("regions[{}].", k - 1) };
+                format!("fluid.initial.{at}{leaf}")
+            };
+            let m = fill.material;
+            let Some(law) = eos.get(m as usize) else {
+                return Err((
+                    which("fluid"),
+                    format!("material {m} is not in the EOS table of {} fluids", eos.len()),
+                ));
+            };
+            let w = &fill.state;
+            law.check_input(w).map_err(|e| {
+                let whose = if eos.len() == 1 {
+                    "the EOS".to_string()
+                } else {
+                    format!("its fluid's EOS (material {m}, {law:?})")
+                };
+                (which("state"), format!("{w:?} is not a valid state of {whose}: {e}"))
             })?;
         }
         for (k, (region, _)) in self.regions.iter().enumerate() {
@@ -53,7 +81,11 @@ impl InitialCondition {
                 ));
             }
         }
-        Ok(State { cons: mesh.coords.iter().map(|&x| eos.prim_to_cons(&self.at(x))).collect() })
+        let fills: Vec<Fill> = mesh.coords.iter().map(|&x| self.at(x)).collect();
+        Ok(State {
+            cons: fills.iter().map(|f| eos[f.material as usize].prim_to_cons(&f.state)).collect(),
+            material: fills.iter().map(|f| f.material).collect(),
+        })
     }
 }
 

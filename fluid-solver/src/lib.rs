@@ -4,9 +4,9 @@
 //!
 //! Modules follow the discretisation: `eos` -> `mesh` (geometry and connectivity only, never
 //! solver state) -> `riemann`, `flux`, `reconstruct`, `bc` -> `state`, `initial` ->
-//! `semidiscretization` (the residual) -> `time` -> `setup` (everything before the first step,
-//! with `memory`) -> `solver` (the run loop) with `output`, `probes` -> `couple` (the coupling
-//! participant) and `check` (`fluid-solver check`). Must not touch: the structure, the IPC
+//! `special_edges`, `two_phase` -> `semidiscretization` (the residual) -> `time` -> `setup`
+//! (everything before the first step, with `memory`) -> `solver` (the run loop) with `output`,
+//! `probes` -> `couple` (the coupling participant) and `check` (`fluid-solver check`). Must not touch: the structure, the IPC
 //! transport (it talks to the structure only through `interface-protocol` endpoints).
 #![deny(unsafe_op_in_unsafe_fn)]
 
@@ -27,5 +27,7 @@ pub mod riemann;
 pub mod semidiscretization;
 pub mod setup;
 pub mod solver;
+pub mod special_edges;
 pub mod state;
 pub mod time;
+pub mod two_phase;

@@ -4,7 +4,7 @@
 //!
 //! The estimate adds up the arrays a run keeps, from their element types: per node the mesh's
 //! coordinates, original ids, dual volumes and dual areas, the gradient operator's inverse
-//! matrix, the conserved state and the five workspace arrays; per edge its two node numbers and
+//! matrix, the conserved state and material id and the five workspace arrays; per edge its two node numbers and
 //! its area normal, at [`EDGES_PER_NODE`] edges per node; per cell its [`Cell`]. `fluid-solver
 //! bench` measured 805 B/node on a tet box, cells included; the test below holds this estimate
 //! to the arrays of a built mesh.
@@ -21,7 +21,7 @@ pub const BYTES_PER_NODE: u64 = {
     let f = size_of::<f64>() as u64;
     let mesh = 3 * f + size_of::<u32>() as u64 + 2 * f;
     let gradient = 6 * f;
-    let state = 5 * f;
+    let state = 5 * f + size_of::<crate::state::MaterialId>() as u64;
     // prim, grad (5 x 3), residual, stage, dt_node.
     let workspace = 5 * f + 15 * f + 5 * f + 5 * f + f;
     let edge = size_of::<[u32; 2]>() as u64 + 3 * f;
@@ -76,7 +76,7 @@ mod tests {
         let held = semi.mesh.memory_bytes()
             + semi.gradient.memory_bytes()
             + ws.memory_bytes()
-            + nodes * size_of::<[f64; 5]>();
+            + crate::state::State::new(vec![[0.0; 5]; nodes]).memory_bytes();
         let estimate = estimate(nodes as f64, cells as f64);
         let ratio = estimate as f64 / held as f64;
         println!("{nodes} nodes, {cells} cells: estimate {estimate} B, held {held} B ({ratio:.3})");

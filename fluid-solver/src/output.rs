@@ -1,8 +1,8 @@
-//! Field output of the fluid: the mesh and nodal ρ, velocity, p (and Mach) as an XDMF/HDF5 time
-//! series (`fluid.h5` + `fluid.xdmf`) through `interface_protocol::io::xdmf`.
+//! Field output of the fluid: the mesh and nodal ρ, velocity, p, Mach and material id as an
+//! XDMF/HDF5 time series (`fluid.h5` + `fluid.xdmf`) through `interface_protocol::io::xdmf`.
 
-use crate::eos::Eos;
 use crate::mesh::{CellKind, Mesh};
+use crate::semidiscretization::Semidiscretization;
 use interface_protocol::io::xdmf::{
     self, CellBlock, Connectivity, Field, Location, TimeSeriesWriter, Values,
 };
@@ -37,10 +37,11 @@ pub fn create_writer(dir: &Path, mesh: &Mesh) -> Result<TimeSeriesWriter, xdmf::
     TimeSeriesWriter::create(dir, "fluid", &xdmf::Mesh { points: &mesh.coords, blocks: &blocks })
 }
 
-/// Writes one time step of the primitive fields.
+/// Writes one time step of the primitive fields, the Mach number (each node's own sound speed)
+/// and the material id of each node (`material`, as a scalar).
 pub fn write_fields(
     writer: &mut TimeSeriesWriter,
-    eos: &Eos,
+    semi: &Semidiscretization,
     time: f64,
     prim: &[[f64; 5]],
 ) -> Result<(), xdmf::XdmfError> {
@@ -49,8 +50,13 @@ pub fn write_fields(
     let v: Vec<[f64; 3]> = prim.iter().map(|w| [w[1], w[2], w[3]]).collect();
     let mach: Vec<f64> = prim
         .iter()
-        .map(|w| (w[1] * w[1] + w[2] * w[2] + w[3] * w[3]).sqrt() / eos.sound_speed(w[0], w[4]))
+        .enumerate()
+        .map(|(i, w)| {
+            let c = semi.eos_at(i).sound_speed(w[0], w[4]);
+            (w[1] * w[1] + w[2] * w[2] + w[3] * w[3]).sqrt() / c
+        })
         .collect();
+    let material: Vec<f64> = semi.material().iter().map(|&m| f64::from(m)).collect();
     writer.write_step(
         time,
         &[
@@ -58,6 +64,7 @@ pub fn write_fields(
             Field { name: "velocity", location: Location::Node, values: Values::Vector(&v) },
             Field { name: "p", location: Location::Node, values: Values::Scalar(&p) },
             Field { name: "mach", location: Location::Node, values: Values::Scalar(&mach) },
+            Field { name: "material", location: Location::Node, values: Values::Scalar(&material) },
         ],
     )
 }

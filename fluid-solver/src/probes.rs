@@ -5,6 +5,7 @@
 
 use crate::mesh::geometry::{add, dot, norm, scale, sub};
 use crate::mesh::{locate, Mesh};
+use crate::state::MaterialId;
 use crate::time::reached;
 use interface_protocol::case::{FluidLine, FluidProbe};
 use interface_protocol::io::probes::LinePoint;
@@ -116,8 +117,9 @@ impl Line {
         self.pending.first().is_some_and(|&lt| reached(t, lt))
     }
 
-    /// The samples of the current state.
-    pub fn sample(&self, prim: &[[f64; 5]]) -> Vec<LinePoint> {
+    /// The samples of the current state: primitive variables and material id (`material`
+    /// column, the fluid's id in the EOS table) of each point's node.
+    pub fn sample(&self, prim: &[[f64; 5]], material: &[MaterialId]) -> Vec<LinePoint> {
         let from = self.points[0];
         self.points
             .iter()
@@ -130,7 +132,7 @@ impl Line {
                     rho: w[0],
                     v: [w[1], w[2], w[3]],
                     p: w[4],
-                    material: 0,
+                    material: u32::from(material[i]),
                 }
             })
             .collect()

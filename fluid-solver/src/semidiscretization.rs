@@ -12,15 +12,24 @@
 //! residual is complete inside the same pass, so the time integrator applies its update there
 //! ([`Semidiscretization::residual_and_update`]) while the node is still in cache.
 //!
+//! Materials (thesis Ch. 3, DESIGN §5.1): the operator holds the EOS table and is built for a
+//! material layout, the material id of every node ([`Semidiscretization::with_materials`]; the
+//! state holds the same ids). A run of one material (the same id at every node) runs the loop
+//! specialised for its EOS, limiter and flux over whole blocks. Otherwise each block runs the
+//! ordinary loop over the gaps between its special edges ([`crate::special_edges`]) with each
+//! edge's EOS looked up from the table, then its special edges: an edge whose ends hold different
+//! fluids takes the two-phase ghost-fluid flux ([`crate::two_phase`]). The least-squares
+//! gradients then use only neighbours of the same fluid (the two-material edges masked out).
+//!
 //! Extension points:
 //! - Embedded boundary (thesis Ch. 4-5): a cut edge gets two one-sided fluxes (Alg. 5.1 for each
 //!   active end node): the edge loop adds `F_ij` to `R_i` and `F_ji` to `R_j`. Inactive nodes are
 //!   masked when their residual completes (zero residual, state frozen), and the gradient
 //!   operator is rebuilt with the cut edges masked out and the same mirror planes
 //!   ([`LsqGradient::with_planes`]).
-//! - Two-phase (thesis Ch. 3): a per-node material id selects the EOS of each end; an edge whose
-//!   ends hold different fluids takes [`crate::flux::two_phase_flux`] (again two one-sided fluxes,
-//!   added as for cut edges); the level set is one more nodal array advected by the same loop.
+//! - Moving interfaces: a level set (one more nodal array advected by the same loop) changes node
+//!   materials between steps; the layout is then rebuilt ([`Semidiscretization::set_materials`]:
+//!   one pass over the edges for the special-edge lists, and the masked gradient operator).
 //! - MPI (DESIGN §10): with owned nodes first and ghosts after, the edge loop runs over edges
 //!   touching an owned node, the update over owned nodes only, and a ghost exchange precedes each
 //!   stage.
@@ -35,7 +44,8 @@ use crate::reconstruct::gradient::{LsqGradient, MirrorPlanes};
 use crate::reconstruct::limiter::Limiter;
 use crate::reconstruct::muscl;
 use crate::riemann::RiemannError;
-use crate::state::Workspace;
+use crate::special_edges::SpecialEdges;
+use crate::state::{MaterialId, Workspace};
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -64,24 +74,58 @@ pub enum FluidError {
     InvalidState { node: usize, position: [f64; 3], prim: [f64; 5], error: StateError },
     #[error("boundary `{boundary}` at node {node} (x = {position:?}): {error}")]
     Boundary { boundary: String, node: usize, position: [f64; 3], error: RiemannError },
+    #[error(
+        "two-phase Riemann problem on edge {edge} between nodes {nodes:?} (materials {materials:?}, \
+         x = {position:?}): {error}"
+    )]
+    TwoPhase {
+        edge: usize,
+        nodes: [usize; 2],
+        materials: [MaterialId; 2],
+        position: [f64; 3],
+        error: RiemannError,
+    },
 }
 
-/// The spatial operator: mesh, EOS, scheme, gradient operator and boundary conditions.
+/// The spatial operator: mesh, EOS table, material layout, scheme, gradient operator and
+/// boundary conditions.
 #[derive(Debug, Clone)]
 pub struct Semidiscretization {
     pub mesh: Mesh,
-    pub eos: Eos,
+    /// The EOS table: material id `m` has the EOS `eos[m]`.
+    pub eos: Vec<Eos>,
+    /// The material id of every node (the layout the operator is built for).
+    material: Vec<MaterialId>,
+    /// The one material of every node, if there is one.
+    uniform: Option<MaterialId>,
+    /// Per edge block, its special edges (here the two-material edges).
+    special: SpecialEdges,
     pub numerics: Numerics,
+    /// Least-squares gradients (with mirror planes; two-material edges masked out).
     pub gradient: LsqGradient,
     /// `(index in mesh.boundaries, condition)`, applied in this order.
     pub patches: Vec<(usize, BoundaryCondition)>,
 }
 
 impl Semidiscretization {
-    /// Builds the operator; every boundary of the mesh needs a condition, given by name.
+    /// The operator of one fluid: every node material 0 of the table `[eos]`; every boundary of
+    /// the mesh needs a condition, given by name.
     pub fn new(
         mesh: Mesh,
         eos: Eos,
+        numerics: Numerics,
+        conditions: &[(String, BoundaryCondition)],
+    ) -> Result<Semidiscretization, MeshError> {
+        let material = vec![0; mesh.n_nodes()];
+        Self::with_materials(mesh, vec![eos], material, numerics, conditions)
+    }
+
+    /// The operator of the EOS table `eos` for the node materials `material` (ids into `eos`,
+    /// one per node); every boundary of the mesh needs a condition, given by name.
+    pub fn with_materials(
+        mesh: Mesh,
+        eos: Vec<Eos>,
+        material: Vec<MaterialId>,
         numerics: Numerics,
         conditions: &[(String, BoundaryCondition)],
     ) -> Result<Semidiscretization, MeshError> {
@@ -111,13 +155,100 @@ impl Semidiscretization {
             .map(|p| p.0)
             .collect();
         let planes = MirrorPlanes::new(&mesh, &mirrors);
+        if eos.is_empty() {
+            return Err(MeshError::Input("the EOS table is empty: give at least one fluid".into()));
+        }
         let gradient = LsqGradient::with_planes(&mesh, None, planes);
-        Ok(Semidiscretization { mesh, eos, numerics, gradient, patches })
+        let mut semi = Semidiscretization {
+            mesh,
+            eos,
+            material: Vec::new(),
+            uniform: None,
+            special: SpecialEdges::none(),
+            numerics,
+            gradient,
+            patches,
+        };
+        semi.set_materials(material)?;
+        Ok(semi)
     }
 
-    /// Primitive variables of every node into `ws.prim`, checked against the EOS.
+    /// Rebuilds the material layout for the node materials `material`: the special-edge lists
+    /// (one pass over the edges) and, when more than one material is present, the gradient
+    /// operator with the two-material edges masked out (same mirror planes).
+    pub fn set_materials(&mut self, material: Vec<MaterialId>) -> Result<(), MeshError> {
+        let n = self.mesh.n_nodes();
+        if material.len() != n {
+            return Err(MeshError::Input(format!(
+                "{} material ids for a mesh of {n} nodes",
+                material.len()
+            )));
+        }
+        if let Some(i) = material.iter().position(|&m| m as usize >= self.eos.len()) {
+            return Err(MeshError::Input(format!(
+                "node {i} (x = {:?}) has material {}, but the EOS table has {} fluids",
+                self.mesh.coords[i],
+                material[i],
+                self.eos.len()
+            )));
+        }
+        let first = material.first().copied().unwrap_or(0);
+        let uniform = material.iter().all(|&m| m == first).then_some(first);
+        let was_masked = self.uniform.is_none() && !self.material.is_empty();
+        self.special = match uniform {
+            Some(_) => SpecialEdges::none(),
+            None => SpecialEdges::two_material(&self.mesh, &material),
+        };
+        if uniform.is_none() || was_masked {
+            let mask: Option<Vec<bool>> = uniform.is_none().then(|| {
+                let m = &material;
+                self.mesh.edges.iter().map(|&[i, j]| m[i as usize] == m[j as usize]).collect()
+            });
+            let planes = self.gradient.planes().clone();
+            self.gradient = LsqGradient::with_planes(&self.mesh, mask.as_deref(), planes);
+        }
+        self.material = material;
+        self.uniform = uniform;
+        Ok(())
+    }
+
+    /// The material id of every node.
+    pub fn material(&self) -> &[MaterialId] {
+        &self.material
+    }
+
+    /// The special edges of every edge block.
+    pub fn special_edges(&self) -> &SpecialEdges {
+        &self.special
+    }
+
+    /// The EOS of node `i`.
+    #[inline(always)]
+    pub fn eos_at(&self, i: usize) -> &Eos {
+        &self.eos[self.material[i] as usize]
+    }
+
+    /// The EOS of every node when all hold one material.
+    #[inline]
+    pub fn uniform_eos(&self) -> Option<Eos> {
+        self.uniform.map(|m| self.eos[m as usize])
+    }
+
+    /// Primitive variables of every node into `ws.prim`, each checked against its node's EOS.
     pub fn primitives(&self, cons: &[[f64; 5]], ws: &mut Workspace) -> Result<(), FluidError> {
-        let eos = self.eos;
+        match self.uniform_eos() {
+            Some(eos) => self.primitives_with(cons, ws, |_| eos),
+            None => self.primitives_with(cons, ws, |i| *self.eos_at(i)),
+        }
+    }
+
+    #[inline(always)]
+    fn primitives_with(
+        &self,
+        cons: &[[f64; 5]],
+        ws: &mut Workspace,
+        eos_of: impl Fn(usize) -> Eos + Sync,
+    ) -> Result<(), FluidError> {
         let first_bad = ws
             .prim
             .par_chunks_mut(NODE_BLOCK)
@@ -126,6 +257,7 @@ impl Semidiscretization {
             .filter_map(|(b, (prim, cons))| {
                 let mut bad = None;
                 for (k, (w, q)) in prim.iter_mut().zip(cons).enumerate() {
+                    let eos = eos_of(b * NODE_BLOCK + k);
                     *w = eos.cons_to_prim(q);
                     if bad.is_none() && eos.check(w).is_err() {
                         bad = Some(b * NODE_BLOCK + k);
@@ -136,7 +268,7 @@ impl Semidiscretization {
             .min();
         if let Some(node) = first_bad {
             let prim = ws.prim[node];
-            let error = eos.check(&prim).expect_err("found invalid above");
+            let error = eos_of(node).check(&prim).expect_err("found invalid above");
             return Err(FluidError::InvalidState {
                 node,
                 position: self.mesh.coords[node],
@@ -179,7 +311,7 @@ impl Semidiscretization {
             for i in blocks.fresh(b) {
                 r[i] = [0.0; 5];
             }
-            self.edge_fluxes(blocks.edges(b), prim, grad, r);
+            self.block_fluxes(b, prim, grad, r)?;
             self.boundary_fluxes(blocks.nodes(b), prim, r)?;
             for i in blocks.completed(b) {
                 update(i, &r[i], &mut o[i]);
@@ -190,48 +322,79 @@ impl Semidiscretization {
 
     /// Only the edge part of the residual, `Σ_j F_ij` without boundary fluxes, from `ws.prim` and
     /// the gradients already in `ws.grad` (the hot loop alone, for benchmarks and for checking the
-    /// C reference loop of `fluid-solver/bench/`).
-    pub fn edge_residual(&self, ws: &mut Workspace) {
+    /// C reference loop of `fluid-solver/bench/`; special edges included).
+    pub fn edge_residual(&self, ws: &mut Workspace) -> Result<(), FluidError> {
         let Workspace { prim, grad, residual, .. } = ws;
         let (prim, grad) = (&prim[..], &grad[..]);
         let blocks = &self.mesh.blocks;
-        let result = blocks.scatter(residual, |b, r| {
+        blocks.scatter(residual, |b, r| {
             for i in blocks.fresh(b) {
                 r[i] = [0.0; 5];
             }
-            self.edge_fluxes(blocks.edges(b), prim, grad, r);
-            Ok::<(), std::convert::Infallible>(())
-        });
-        let Ok(()) = result;
+            self.block_fluxes(b, prim, grad, r)
+        })
+    }
+
+    /// Adds the fluxes of the edges of block `b`: with one material, the specialised loop over
+    /// the whole block; otherwise the ordinary loop over the gaps between the block's special
+    /// edges, then the special edges.
+    #[inline]
+    fn block_fluxes(
+        &self,
+        b: usize,
+        prim: &[[f64; 5]],
+        grad: &[[[f64; 3]; 5]],
+        r: &mut Window<'_, [f64; 5]>,
+    ) -> Result<(), FluidError> {
+        let edges = self.mesh.blocks.edges(b);
+        if let Some(eos) = self.uniform_eos() {
+            self.edge_fluxes(eos, edges, prim, grad, r);
+            return Ok(());
+        }
+        let (table, material) = (&self.eos[..], &self.material[..]);
+        let limiter = self.numerics.limiter;
+        for gap in self.special.gaps(b, edges) {
+            self.edge_loop(|i| table[material[i] as usize], limiter, gap, prim, grad, r);
+        }
+        crate::two_phase::special_fluxes(self, self.special.block(b), prim, r)
     }
 
     /// Adds the fluxes of `edges` to the residuals of their end nodes, with the scheme's limiter,
-    /// flux and EOS fixed outside the edge loop (so each combination is its own tight loop).
+    /// flux and the one EOS fixed outside the edge loop (so each combination is its own tight
+    /// loop).
     fn edge_fluxes(
         &self,
+        eos: Eos,
         edges: Range<usize>,
         prim: &[[f64; 5]],
         grad: &[[[f64; 3]; 5]],
         r: &mut Window<'_, [f64; 5]>,
     ) {
         let limiter = self.numerics.limiter;
-        match self.eos {
+        match eos {
             Eos::PerfectGas { gamma } => {
-                self.edge_loop(Eos::PerfectGas { gamma }, limiter, edges, prim, grad, r)
+                self.edge_loop(|_| Eos::PerfectGas { gamma }, limiter, edges, prim, grad, r)
             }
             Eos::StiffenedGas { gamma, p_c } => {
-                self.edge_loop(Eos::StiffenedGas { gamma, p_c }, limiter, edges, prim, grad, r)
+                self.edge_loop(|_| Eos::StiffenedGas { gamma, p_c }, limiter, edges, prim, grad, r)
             }
-            Eos::Tait { p0, rho0, alpha, beta } => {
-                self.edge_loop(Eos::Tait { p0, rho0, alpha, beta }, limiter, edges, prim, grad, r)
-            }
+            Eos::Tait { p0, rho0, alpha, beta } => self.edge_loop(
+                |_| Eos::Tait { p0, rho0, alpha, beta },
+                limiter,
+                edges,
+                prim,
+                grad,
+                r,
+            ),
         }
     }
 
+    /// The loop of the scheme's flux and limiter; `eos_of(i)` is the EOS of an edge whose first
+    /// node is `i` (both ends share it).
     #[inline(always)]
     fn edge_loop(
         &self,
-        eos: Eos,
+        eos: impl Fn(usize) -> Eos + Copy,
         limiter: Limiter,
         edges: Range<usize>,
         prim: &[[f64; 5]],
@@ -277,7 +440,7 @@ impl Semidiscretization {
     #[inline(always)]
     fn edge_loop_with(
         &self,
-        eos: Eos,
+        eos_of: impl Fn(usize) -> Eos,
         limiter: Limiter,
         flux: FluxScheme,
         edges: Range<usize>,
@@ -290,6 +453,7 @@ impl Semidiscretization {
             let [i, j] = mesh.edges[e];
             let (i, j) = (i as usize, j as usize);
             let n = &mesh.edge_normals[e];
+            let eos = eos_of(i);
             let f = if limiter == Limiter::FirstOrder {
                 numerical_flux(flux, &eos, &prim[i], &prim[j], n)
             } else {
@@ -320,13 +484,13 @@ impl Semidiscretization {
             for k in node_range(&boundary.nodes, &nodes) {
                 let node = boundary.nodes[k] as usize;
                 let f = bc
-                    .flux(self.numerics.flux, &self.eos, &prim[node], &boundary.normals[k])
+                    .flux(self.numerics.flux, self.eos_at(node), &prim[node], &boundary.normals[k])
                     .map_err(|error| FluidError::Boundary {
-                    boundary: boundary.name.clone(),
-                    node,
-                    position: self.mesh.coords[node],
-                    error,
-                })?;
+                        boundary: boundary.name.clone(),
+                        node,
+                        position: self.mesh.coords[node],
+                        error,
+                    })?;
                 for c in 0..5 {
                     r[node][c] += f[c];
                 }
@@ -345,7 +509,6 @@ impl Semidiscretization {
     /// residual.
     pub fn node_time_steps(&self, ws: &mut Workspace) {
         let mesh = &self.mesh;
-        let eos = self.eos;
         let prim = &ws.prim[..];
         let blocks = &mesh.blocks;
         let u_dot = |w: &[f64; 5], n: &[f64; 3]| dot([w[1], w[2], w[3]], *n).abs();
@@ -368,7 +531,7 @@ impl Semidiscretization {
             }
             for i in blocks.completed(b) {
                 let w = &prim[i];
-                let c = eos.sound_speed(w[0], w[4]);
+                let c = self.eos_at(i).sound_speed(w[0], w[4]);
                 lambda[i] = 2.0 * mesh.volumes[i] / (lambda[i] + c * mesh.dual_areas[i]);
             }
             Ok::<(), std::convert::Infallible>(())

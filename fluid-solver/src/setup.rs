@@ -1,22 +1,23 @@
 //! From a case's `[fluid]` section to a ready problem: everything a run does before its first
 //! step, shared by `run` (alone and coupled) and `check` so that they cannot drift. The mesh
-//! (refused before it is built if it cannot fit in memory), EOS, scheme, boundary conditions,
-//! initial state (every state admissible for the EOS, every region holding a node), probes and
-//! lines (inside the mesh; a line time after the end is a warning), and the initial CFL step (a run that would
-//! take more than `resources::MAX_STEPS` steps is refused). Errors name the case field
-//! (`fluid.<...>`) and what was expected.
+//! (refused before it is built if it cannot fit in memory), the EOS table of the fluids, scheme,
+//! boundary conditions (each state admissible for every fluid on its boundary), initial state and
+//! node materials (every state admissible for its own fluid's EOS, every region holding a node),
+//! probes and lines (inside the mesh; a line time after the end is a warning), and the initial CFL
+//! step (a run that would take more than `resources::MAX_STEPS` steps is refused). Errors name the
+//! case field (`fluid.<...>`) and what was expected.
 
 use crate::bc::BoundaryCondition;
 use crate::eos::Eos;
 use crate::flux::FluxScheme;
-use crate::initial::InitialCondition;
+use crate::initial::{Fill, InitialCondition};
 use crate::memory;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec};
 use crate::mesh::{gmsh, Mesh};
 use crate::probes::{self, Placed};
 use crate::reconstruct::limiter::Limiter;
 use crate::semidiscretization::{Numerics, Semidiscretization};
-use crate::state::{State, Workspace};
+use crate::state::{MaterialId, State, Workspace};
 use crate::time::cfl::stable_time_step;
 use crate::time::{reached, TimeStepping};
 use interface_protocol::case::{BoxShape, Case, FluidBoundary, FluidProbe, FluidSection};
@@ -38,6 +39,8 @@ pub enum Mode {
 #[derive(Debug, Clone)]
 pub struct Problem {
     pub semi: Semidiscretization,
+    /// The name of each fluid, by material id.
+    pub fluid_names: Vec<String>,
     pub initial: State,
     pub stepping: TimeStepping,
     /// The end of the run: `fluid.time.t_end` alone, `coupling.t_end` coupled.
@@ -125,17 +128,30 @@ pub fn mesh(case: &Case) -> anyhow::Result<Mesh> {
     Mesh::build(raw).map_err(|e| field_error(case, "fluid.mesh", e))
 }
 
-/// The EOS of `fluid.eos`.
-pub fn eos(case: &Case) -> anyhow::Result<Eos> {
+/// The fluids of `fluid.eos` or `[fluid.fluids]`: their names and the EOS table, by material id.
+pub fn fluids(case: &Case) -> anyhow::Result<(Vec<String>, Vec<Eos>)> {
     let f = section(case)?;
-    let v = f.eos.clone().ok_or_else(|| {
-        field_error(
+    let materials = f.materials();
+    if materials.is_empty() {
+        return Err(field_error(
             case,
             "fluid.eos",
-            "missing: e.g. eos = { kind = \"perfect_gas\", gamma = 1.4 }",
-        )
-    })?;
-    v.try_into::<Eos>().map_err(|e| field_error(case, "fluid.eos", e.message().trim()))
+            "missing: e.g. eos = { kind = \"perfect_gas\", gamma = 1.4 }, or named fluids \
+             [fluid.fluids.<name>] with an eos each",
+        ));
+    }
+    let mut names = Vec::new();
+    let mut table = Vec::new();
+    for m in materials {
+        let eos = m
+            .eos
+            .clone()
+            .try_into::<Eos>()
+            .map_err(|e| field_error(case, &m.eos_field, e.message().trim()))?;
+        names.push(m.name.to_string());
+        table.push(eos);
+    }
+    Ok((names, table))
 }
 
 /// The spatial scheme of `[fluid.numerics]`.
@@ -156,8 +172,27 @@ pub fn numerics(case: &Case) -> anyhow::Result<Numerics> {
 pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
     let f = section(case)?;
     let mesh = mesh(case)?;
-    let eos = eos(case)?;
+    let (fluid_names, table) = fluids(case)?;
     let numerics = numerics(case)?;
+    let init = f.initial.as_ref().ok_or_else(|| {
+        field_error(case, "fluid.initial", "missing: give `state = [ρ, u, v, w, p]`")
+    })?;
+    // Reading the case checked the names (this is its message for a case built otherwise).
+    let (background, region_ids) = f.initial_materials().ok_or_else(|| {
+        field_error(case, "fluid.initial.fluid", "an unknown or missing fluid name")
+    })?;
+    let id = |m: usize| m as MaterialId;
+    let ic = InitialCondition {
+        background: Fill { state: init.state, material: id(background) },
+        regions: init
+            .regions
+            .iter()
+            .zip(region_ids)
+            .map(|(r, m)| (r.region, Fill { state: r.state, material: id(m) }))
+            .collect(),
+    };
+    let initial =
+        ic.state(&mesh, &table).map_err(|(field, message)| field_error(case, &field, message))?;
     let mut conditions = Vec::new();
     for (name, b) in &f.boundary {
         if !mesh.boundaries.iter().any(|m| &m.name == name) {
@@ -170,9 +205,29 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
                 ),
             ));
         }
+        // The fluids initially on this boundary: each must admit its state.
+        let index = mesh.boundaries.iter().position(|m| &m.name == name).expect("found above");
+        let mut present = vec![false; table.len()];
+        for &i in &mesh.boundaries[index].nodes {
+            present[initial.material[i as usize] as usize] = true;
+        }
+        let on_boundary: Vec<(usize, &Eos)> =
+            table.iter().enumerate().filter(|(m, _)| present[*m]).collect();
+        let whose = |m: usize| match table.len() {
+            1 => String::new(),
+            _ => format!(" (for fluid `{}` on this boundary)", fluid_names[m]),
+        };
         let check = |w: &[f64; 5]| {
-            eos.check_input(w)
-                .map_err(|e| field_error(case, &format!("fluid.boundary.{name}.state"), e))
+            for &(m, eos) in &on_boundary {
+                eos.check_input(w).map_err(|e| {
+                    field_error(
+                        case,
+                        &format!("fluid.boundary.{name}.state"),
+                        format!("{e}{}", whose(m)),
+                    )
+                })?;
+            }
+            Ok::<(), anyhow::Error>(())
         };
         let bc = match *b {
             FluidBoundary::SlipWall => BoundaryCondition::SlipWall,
@@ -186,36 +241,37 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
                 BoundaryCondition::Inflow { state }
             }
             FluidBoundary::Outflow { pressure } => {
-                let p_min = eos.min_pressure();
-                let admitted =
-                    if eos.is_barotropic() { pressure >= p_min } else { pressure > p_min };
-                if !admitted {
-                    return Err(field_error(
-                        case,
-                        &format!("fluid.boundary.{name}.pressure"),
-                        format!(
-                            "{pressure} is at or below the lowest pressure {p_min} the EOS admits"
-                        ),
-                    ));
+                for &(m, eos) in &on_boundary {
+                    let p_min = eos.min_pressure();
+                    let admitted =
+                        if eos.is_barotropic() { pressure >= p_min } else { pressure > p_min };
+                    if !admitted {
+                        return Err(field_error(
+                            case,
+                            &format!("fluid.boundary.{name}.pressure"),
+                            format!(
+                                "{pressure} is at or below the lowest pressure {p_min} the EOS \
+                                 admits{}",
+                                whose(m)
+                            ),
+                        ));
+                    }
                 }
                 BoundaryCondition::Outflow { pressure }
             }
         };
         conditions.push((name.clone(), bc));
     }
-    let init = f.initial.as_ref().ok_or_else(|| {
-        field_error(case, "fluid.initial", "missing: give `state = [ρ, u, v, w, p]`")
-    })?;
-    let ic = InitialCondition {
-        background: init.state,
-        regions: init.regions.iter().map(|r| (r.region, r.state)).collect(),
-    };
-    let initial =
-        ic.state(&mesh, &eos).map_err(|(field, message)| field_error(case, &field, message))?;
     let placed = probes::place(&mesh, &f.probes, &f.lines)
         .map_err(|(field, message)| field_error(case, &field, message))?;
-    let semi = Semidiscretization::new(mesh, eos, numerics, &conditions)
-        .map_err(|e| field_error(case, "fluid.boundary", e))?;
+    let semi = Semidiscretization::with_materials(
+        mesh,
+        table,
+        initial.material.clone(),
+        numerics,
+        &conditions,
+    )
+    .map_err(|e| field_error(case, "fluid.boundary", e))?;
     let (t_end, end_key, max_steps) = match mode {
         Mode::Alone => {
             let time = f.time.as_ref().ok_or_else(|| {
@@ -266,6 +322,7 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
     }
     Ok(Problem {
         semi,
+        fluid_names,
         initial,
         stepping,
         t_end,

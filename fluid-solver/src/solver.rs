@@ -10,8 +10,8 @@
 //! and the CFL step resumes after it.
 //!
 //! A restarted run is bitwise identical to an uninterrupted one: the state is the conserved
-//! array plus `(step, t)`, and the time step depends only on them, on the target time and on the
-//! output times after `t`.
+//! array and the node materials plus `(step, t)`, and the time step depends only on them, on the
+//! target time and on the output times after `t`.
 
 use crate::output;
 use crate::probes::{Line, Placed};
@@ -53,20 +53,26 @@ pub struct RunSummary {
     pub nodes: usize,
 }
 
-/// Reads the conserved state of the newest checkpoint under `run_dir/checkpoints`.
+/// Reads the conserved state and node materials of the newest checkpoint under
+/// `run_dir/checkpoints` (a checkpoint without `material` is of one fluid, material 0).
 pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State, u64, f64)> {
     let dir = run_dir.join("checkpoints");
     let found = checkpoint::latest(&dir, &[CHECKPOINT_PART])?
         .with_context(|| format!("no complete fluid checkpoint in {}", dir.display()))?;
     let ck = Checkpoint::read(&dir, &found.tag, CHECKPOINT_PART)?;
     let cons = ck.f64_n::<5>("cons")?;
+    let material = match ck.names().any(|n| n == "material") {
+        true => ck.u8("material")?.to_vec(),
+        false => vec![0; cons.len()],
+    };
     anyhow::ensure!(
-        cons.len() == n_nodes,
-        "checkpoint {} holds {} nodes, but the case's mesh has {n_nodes}",
+        cons.len() == n_nodes && material.len() == n_nodes,
+        "checkpoint {} holds {} nodes ({} material ids), but the case's mesh has {n_nodes}",
         found.dir.display(),
-        cons.len()
+        cons.len(),
+        material.len()
     );
-    Ok((State { cons }, ck.step, ck.time))
+    Ok((State { cons, material }, ck.step, ck.time))
 }
 
 pub use crate::setup::Mode;
@@ -121,13 +127,24 @@ impl<'a> FluidRun<'a> {
         for w in &problem.warnings {
             eprintln!("fluid-solver: warning: {w}");
         }
-        let Problem { semi, initial, stepping, t_end, max_steps, probes, placed, .. } = problem;
+        let Problem { mut semi, initial, stepping, t_end, max_steps, probes, placed, .. } = problem;
         let Placed { probe_nodes, mut lines } = placed;
         // Read the checkpoint before the output folder is made: it may be the same folder.
         let (state, step, t) = match &opts.restart {
             Some(dir) => read_checkpoint(dir, semi.mesh.n_nodes())?,
             None => (initial, 0, 0.0),
         };
+        if state.material != semi.material() {
+            if let Some((i, &m)) =
+                state.material.iter().enumerate().find(|(_, &m)| m as usize >= semi.eos.len())
+            {
+                anyhow::bail!(
+                    "the checkpoint gives node {i} material {m}, but the case has {} fluids",
+                    semi.eos.len()
+                );
+            }
+            semi.set_materials(state.material.clone())?;
+        }
         let policy = match mode {
             Mode::Alone => Policy::alone(opts.force, opts.restart.as_deref(), &opts.out),
             Mode::Coupled => Policy::Existing,
@@ -145,7 +162,7 @@ impl<'a> FluidRun<'a> {
         let mut fields = output::create_writer(out.path(), &semi.mesh)?;
         let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
         let probe_csv = ProbeWriter::fluid(out.path(), &names)?;
-        output::write_fields(&mut fields, &semi.eos, t, &ws.prim)?;
+        output::write_fields(&mut fields, &semi, t, &ws.prim)?;
         let bar = Progress::new(t_end, opts.quiet || mode == Mode::Coupled);
         let mut run = FluidRun {
             case,
@@ -213,7 +230,8 @@ impl<'a> FluidRun<'a> {
                     line.pending.remove(0);
                 }
                 let name = format!("{}_t{t:.6e}", line.name);
-                write_line_sample(&self.out.lines()?, &name, &line.sample(&self.ws.prim))?;
+                let sample = line.sample(&self.ws.prim, &self.state.material);
+                write_line_sample(&self.out.lines()?, &name, &sample)?;
             }
         }
         Ok(())
@@ -278,7 +296,7 @@ impl<'a> FluidRun<'a> {
                 self.write_probes()?;
             }
             if want_fields {
-                output::write_fields(&mut self.fields, &self.semi.eos, t, &self.ws.prim)?;
+                output::write_fields(&mut self.fields, &self.semi, t, &self.ws.prim)?;
                 self.last_fields_step = step;
             }
             self.write_due_lines()?;
@@ -306,11 +324,13 @@ impl<'a> FluidRun<'a> {
         self.status.is_err()
     }
 
-    /// Writes the conserved state as the checkpoint `tag` (part [`CHECKPOINT_PART`]).
+    /// Writes the conserved state and node materials as the checkpoint `tag` (part
+    /// [`CHECKPOINT_PART`]).
     pub fn write_checkpoint(&mut self, tag: &str) -> anyhow::Result<()> {
         let start = Instant::now();
         let mut ck = Checkpoint::new(self.step, self.t);
         ck.put_f64_n("cons", &self.state.cons)?;
+        ck.put("material", self.state.material.clone())?;
         ck.write(&self.out.checkpoints()?, tag, CHECKPOINT_PART)?;
         self.timers.add_since(bucket::OUTPUT, start);
         Ok(())
@@ -326,10 +346,11 @@ impl<'a> FluidRun<'a> {
             let start = Instant::now();
             self.semi.primitives(&self.state.cons, &mut self.ws)?;
             if self.last_fields_step != self.step {
-                output::write_fields(&mut self.fields, &self.semi.eos, self.t, &self.ws.prim)?;
+                output::write_fields(&mut self.fields, &self.semi, self.t, &self.ws.prim)?;
             }
             for line in &self.lines {
-                write_line_sample(&self.out.lines()?, &line.name, &line.sample(&self.ws.prim))?;
+                let sample = line.sample(&self.ws.prim, &self.state.material);
+                write_line_sample(&self.out.lines()?, &line.name, &sample)?;
             }
             self.timers.add_since(bucket::OUTPUT, start);
             if self.mode == Mode::Alone {

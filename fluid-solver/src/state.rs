@@ -6,16 +6,27 @@
 //! is stored per edge: the edge loop adds its fluxes straight into the nodal residuals
 //! ([`crate::mesh::EdgeBlocks`]).
 //!
-//! Two-phase flow (DESIGN §5, thesis Ch. 3) adds a material id and a level set per node as two
-//! more arrays of this struct; MPI adds ghost nodes after the owned ones.
+//! Two-phase flow (DESIGN §5, thesis Ch. 3): each node holds a material id, its fluid's index in
+//! the EOS table of [`crate::semidiscretization::Semidiscretization`]; the level set will be one
+//! more array here. MPI adds ghost nodes after the owned ones.
 
-/// Conserved variables `[ρ, ρu, ρv, ρw, E]` at every node.
+/// A node's material: its fluid's index in the EOS table.
+pub type MaterialId = u8;
+
+/// Conserved variables `[ρ, ρu, ρv, ρw, E]` and the material id of every node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
     pub cons: Vec<[f64; 5]>,
+    pub material: Vec<MaterialId>,
 }
 
 impl State {
+    /// A state of one fluid (material 0 everywhere).
+    pub fn new(cons: Vec<[f64; 5]>) -> State {
+        let material = vec![0; cons.len()];
+        State { cons, material }
+    }
+
     /// Number of nodes.
     pub fn len(&self) -> usize {
         self.cons.len()
@@ -23,6 +34,11 @@ impl State {
 
     pub fn is_empty(&self) -> bool {
         self.cons.is_empty()
+    }
+
+    /// Memory in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.cons[..]) + std::mem::size_of_val(&self.material[..])
     }
 }
 

@@ -210,7 +210,7 @@ fn each_named_group_carries_its_own_boundary_condition() {
                 .collect();
             let numerics = Numerics { flux: FluxScheme::Roe, limiter: Limiter::VanAlbada };
             let semi = Semidiscretization::new(mesh.clone(), GAS, numerics, &conditions).unwrap();
-            let state = InitialCondition::uniform(rest).state(&semi.mesh, &GAS).unwrap();
+            let state = InitialCondition::uniform(rest).state(&semi.mesh, &[GAS]).unwrap();
             let mut ws = Workspace::new(semi.mesh.n_nodes());
             semi.residual(&state.cons, &mut ws).unwrap();
             let moved: Vec<u32> = (0..semi.mesh.n_nodes() as u32)
@@ -244,7 +244,7 @@ fn free_stream_is_preserved_on_gmsh_meshes() {
         for flux in [FluxScheme::Roe, FluxScheme::Hllc] {
             let numerics = Numerics { flux, limiter: Limiter::VanAlbada };
             let semi = Semidiscretization::new(mesh.clone(), GAS, numerics, &conditions).unwrap();
-            let mut state = InitialCondition::uniform(w).state(&semi.mesh, &GAS).unwrap();
+            let mut state = InitialCondition::uniform(w).state(&semi.mesh, &[GAS]).unwrap();
             let initial = state.clone();
             let mut ws = Workspace::new(semi.mesh.n_nodes());
             for _ in 0..5 {

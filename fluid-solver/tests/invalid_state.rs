@@ -115,7 +115,7 @@ fn non_positive_density_is_reported_with_its_node_and_values() {
     let case = Case::load(&path, &["fluid.mesh.box.cells=[20,1,1]".to_string()]).unwrap();
     let problem = setup::problem(&case, Mode::Alone).unwrap();
     let semi = &problem.semi;
-    let eos = semi.eos;
+    let eos = semi.eos[0];
     assert!(matches!(eos, Eos::PerfectGas { .. }));
     let mut state = problem.initial.clone();
     let node = semi.mesh.n_nodes() / 3;

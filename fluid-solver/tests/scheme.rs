@@ -49,7 +49,7 @@ fn free_stream_is_preserved_on_a_perturbed_tet_mesh() {
             &all(BoundaryCondition::FarField { state: w }),
         )
         .unwrap();
-        let mut state = InitialCondition::uniform(w).state(&semi.mesh, &GAS).unwrap();
+        let mut state = InitialCondition::uniform(w).state(&semi.mesh, &[GAS]).unwrap();
         let initial = state.clone();
         march(&semi, &mut state, 0.2, 0.9);
         let q0 = GAS.prim_to_cons(&w);
@@ -72,8 +72,7 @@ fn residuals_sum_to_the_boundary_flux() {
     bcs[3].1 = BoundaryCondition::Outflow { pressure: 0.8 };
     bcs[4].1 = BoundaryCondition::Inflow { state: [1.1, 0.0, 0.0, 0.4, 1.0] };
     let semi = Semidiscretization::new(mesh, GAS, Numerics::default(), &bcs).unwrap();
-    let state =
-        State { cons: semi.mesh.coords.iter().map(|&x| GAS.prim_to_cons(&wavy(x))).collect() };
+    let state = State::new(semi.mesh.coords.iter().map(|&x| GAS.prim_to_cons(&wavy(x))).collect());
     let mut ws = Workspace::new(semi.mesh.n_nodes());
     semi.residual(&state.cons, &mut ws).unwrap();
     let boundary = semi.boundary_flux_total(&ws.prim).unwrap();
@@ -98,7 +97,7 @@ fn five_steps(threads: usize) -> Vec<[f64; 5]> {
         // Enough edge blocks that both threads get some in each phase.
         assert!(semi.mesh.blocks.len() >= 6, "{} edge blocks", semi.mesh.blocks.len());
         let mut state =
-            State { cons: semi.mesh.coords.iter().map(|&x| GAS.prim_to_cons(&wavy(x))).collect() };
+            State::new(semi.mesh.coords.iter().map(|&x| GAS.prim_to_cons(&wavy(x))).collect());
         let mut ws = Workspace::new(semi.mesh.n_nodes());
         for _ in 0..5 {
             rk2_step(&semi, &mut state, &mut ws, TimeStepping::Global { cfl: 0.9 }, 1.0).unwrap();
@@ -129,14 +128,13 @@ fn entropy_wave_errors(n: usize, limiter: Limiter) -> (f64, f64) {
     bcs[1].1 = BoundaryCondition::FarField { state: free };
     let numerics = Numerics { flux: FluxScheme::Roe, limiter };
     let semi = Semidiscretization::new(mesh, GAS, numerics, &bcs).unwrap();
-    let mut state = State {
-        cons: semi
-            .mesh
+    let mut state = State::new(
+        semi.mesh
             .coords
             .iter()
             .map(|x| GAS.prim_to_cons(&[rho(x[0], 0.0), 1.0, 0.0, 0.0, 1.0]))
             .collect(),
-    };
+    );
     march(&semi, &mut state, t_end, 0.9);
     let values: Vec<f64> = state.cons.iter().map(|q| q[0]).collect();
     let exact = |x: [f64; 3]| rho(x[0], t_end);
@@ -179,9 +177,8 @@ fn local_time_stepping_reaches_the_uniform_channel_flow() {
     bcs[0].1 = BoundaryCondition::Inflow { state: stream };
     bcs[1].1 = BoundaryCondition::FarField { state: stream };
     let semi = Semidiscretization::new(mesh, GAS, Numerics::default(), &bcs).unwrap();
-    let mut state = State {
-        cons: semi
-            .mesh
+    let mut state = State::new(
+        semi.mesh
             .coords
             .iter()
             .map(|x| {
@@ -189,7 +186,7 @@ fn local_time_stepping_reaches_the_uniform_channel_flow() {
                 GAS.prim_to_cons(&[1.0 + bump, 0.3, 0.0, 0.0, 1.0])
             })
             .collect(),
-    };
+    );
     let mut ws = Workspace::new(semi.mesh.n_nodes());
     for _ in 0..STEADY_STEPS {
         rk2_step(&semi, &mut state, &mut ws, TimeStepping::Local { cfl: 0.9 }, f64::INFINITY)

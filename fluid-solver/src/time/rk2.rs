@@ -16,6 +16,7 @@ pub fn rk2_step(
     stepping: TimeStepping,
     dt_max: f64,
 ) -> Result<f64, FluidError> {
+    debug_assert!(state.material == semi.material(), "state and operator material layouts differ");
     let dt_min = stable_time_step(semi, &state.cons, ws)?;
     let dt_global = (stepping.cfl() * dt_min).min(dt_max);
     let local = matches!(stepping, TimeStepping::Local { .. });

@@ -56,14 +56,11 @@ pub fn shock_tube(
 ) -> (Semidiscretization, State) {
     let mesh =
         Mesh::build(BoxSpec::tube(0.0, 1.0, n, 4.0 / n as f64, shape).raw().unwrap()).unwrap();
-    let ic = InitialCondition {
-        background: left,
-        regions: vec![(
-            Region::HalfSpace { point: [x0, 0.0, 0.0], normal: [1.0, 0.0, 0.0] },
-            right,
-        )],
-    };
-    let state = ic.state(&mesh, &eos).unwrap();
+    let ic = InitialCondition::single(
+        left,
+        &[(Region::HalfSpace { point: [x0, 0.0, 0.0], normal: [1.0, 0.0, 0.0] }, right)],
+    );
+    let state = ic.state(&mesh, &[eos]).unwrap();
     let semi = Semidiscretization::new(mesh, eos, numerics, &tube_conditions(left, right)).unwrap();
     (semi, state)
 }

@@ -1,9 +1,28 @@
 //! `[fluid]`: which fluid participant runs, and the settings of `fluid-solver` (DESIGN §5).
 //!
 //! Settings of `fluid-solver` are optional here (a case may couple the analytic piston fluid
-//! instead); `fluid-solver` checks that what it needs is present when it runs. The EOS table, the
+//! instead); `fluid-solver` checks that what it needs is present when it runs. The EOS tables, the
 //! flux and the limiter names are checked by `fluid-solver` against its own types (it owns them),
 //! with the same `fluid.<field>` names in its errors.
+//!
+//! Fluids: either one `eos` (a single fluid, named [`SINGLE_FLUID`]) or named fluids, each a
+//! `[fluid.fluids.<name>]` table with its own `eos` (not both). Material ids number the fluids in
+//! ascending order of their names ([`FluidSection::materials`]); they are what the per-node
+//! `material` of the solver, its lines and its field output hold. The initial background names
+//! its fluid with `fluid = "<name>"` (needed when there are several) and each region may name
+//! another (default: the background's).
+//!
+//! ```toml
+//! [fluid.fluids.air]
+//! eos = { kind = "perfect_gas", gamma = 1.4 }
+//! [fluid.fluids.water]
+//! eos = { kind = "stiffened_gas", gamma = 4.4, p_c = 6e8 }
+//! [fluid.initial]
+//! fluid = "air"
+//! state = [1.2, 0, 0, 0, 1e5]
+//! regions = [{ region = { shape = "sphere", center = [0, 0, 0], radius = 0.1 },
+//!              fluid = "water", state = [1000, 0, 0, 0, 1e5] }]
+//! ```
 //!
 //! ```toml
 //! [fluid]
@@ -52,9 +71,13 @@ pub struct FluidSection {
     /// `[fluid.mesh]`.
     #[serde(default)]
     pub mesh: Option<FluidMesh>,
-    /// The equation of state, a table with a `kind` key (`perfect_gas`, `stiffened_gas`, `tait`).
+    /// The equation of state of a single fluid (named [`SINGLE_FLUID`]), a table with a `kind`
+    /// key (`perfect_gas`, `stiffened_gas`, `tait`).
     #[serde(default)]
     pub eos: Option<toml::Value>,
+    /// `[fluid.fluids.<name>]`: named fluids, instead of `eos`.
+    #[serde(default)]
+    pub fluids: BTreeMap<String, NamedFluid>,
     /// `[fluid.initial]`.
     #[serde(default)]
     pub initial: Option<FluidInitial>,
@@ -76,6 +99,29 @@ pub struct FluidSection {
     /// `[fluid.embedded]`: an embedded surface with a prescribed motion (fluid-alone runs).
     #[serde(default)]
     pub embedded: Option<super::FluidEmbedded>,
+}
+
+/// The name of the one fluid of a case that gives `fluid.eos` (not `[fluid.fluids]`).
+pub const SINGLE_FLUID: &str = "fluid";
+
+/// Most fluids a case may name (material ids are one byte).
+pub const MAX_FLUIDS: usize = 256;
+
+/// `[fluid.fluids.<name>]`: one named fluid.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NamedFluid {
+    /// Its equation of state, a table with a `kind` key (as `fluid.eos`).
+    pub eos: toml::Value,
+}
+
+/// One fluid of a case with its material id (its place in [`FluidSection::materials`]).
+#[derive(Debug, Clone)]
+pub struct FluidMaterial<'a> {
+    pub name: &'a str,
+    /// The case field of its EOS: `fluid.eos` or `fluid.fluids.<name>.eos`.
+    pub eos_field: String,
+    pub eos: &'a toml::Value,
 }
 
 /// `[fluid.mesh]`: a box mesh or a gmsh file (exactly one).
@@ -122,6 +168,9 @@ fn ones() -> [f64; 3] {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FluidInitial {
+    /// The fluid everywhere (a name of `[fluid.fluids]`); needed when there are several.
+    #[serde(default)]
+    pub fluid: Option<String>,
     /// Primitive `[ρ, u, v, w, p]` everywhere.
     pub state: [f64; 5],
     #[serde(default)]
@@ -133,6 +182,9 @@ pub struct FluidInitial {
 #[serde(deny_unknown_fields)]
 pub struct InitialRegion {
     pub region: Region,
+    /// The fluid inside; default the background's.
+    #[serde(default)]
+    pub fluid: Option<String>,
     /// Primitive `[ρ, u, v, w, p]` inside.
     pub state: [f64; 5],
 }
@@ -322,7 +374,105 @@ impl FluidSection {
         self.command.clone().unwrap_or_else(|| vec!["fluid-solver".to_string()])
     }
 
+    /// The fluids by material id (ascending names): the one fluid [`SINGLE_FLUID`] of `eos`, or
+    /// those of `[fluid.fluids]`; empty when neither is given.
+    pub fn materials(&self) -> Vec<FluidMaterial<'_>> {
+        match &self.eos {
+            Some(eos) => {
+                vec![FluidMaterial { name: SINGLE_FLUID, eos_field: "fluid.eos".into(), eos }]
+            }
+            None => self
+                .fluids
+                .iter()
+                .map(|(name, f)| FluidMaterial {
+                    name,
+                    eos_field: format!("fluid.fluids.{name}.eos"),
+                    eos: &f.eos,
+                })
+                .collect(),
+        }
+    }
+
+    /// The material id of the fluid `name` ([`FluidSection::materials`]).
+    pub fn material_id(&self, name: &str) -> Option<usize> {
+        self.materials().iter().position(|m| m.name == name)
+    }
+
+    /// The material ids of the initial background and of each initial region, in order (a region
+    /// without `fluid` takes the background's; a background without one the only fluid).
+    /// `None` where the case's validation refuses the names.
+    pub fn initial_materials(&self) -> Option<(usize, Vec<usize>)> {
+        let init = self.initial.as_ref()?;
+        let background = match &init.fluid {
+            Some(name) => self.material_id(name)?,
+            None if self.materials().len() == 1 => 0,
+            None => return None,
+        };
+        let regions = init
+            .regions
+            .iter()
+            .map(|r| r.fluid.as_ref().map_or(Some(background), |name| self.material_id(name)))
+            .collect::<Option<Vec<usize>>>()?;
+        Some((background, regions))
+    }
+
+    /// Checks the fluid names: `eos` or `fluids`, not both; names known where they are used.
+    fn validate_fluids(&self) -> Result<(), (String, String)> {
+        if self.eos.is_some() && !self.fluids.is_empty() {
+            return Err((
+                "fluid.fluids".into(),
+                format!(
+                    "give either `eos` (one fluid, named `{SINGLE_FLUID}`) or `[fluid.fluids.<name>]` \
+                     tables with an `eos` each, not both"
+                ),
+            ));
+        }
+        if let Some(name) = self.fluids.keys().find(|n| n.is_empty()) {
+            return Err((format!("fluid.fluids.{name}"), "a fluid needs a non-empty name".into()));
+        }
+        if self.fluids.len() > MAX_FLUIDS {
+            return Err((
+                "fluid.fluids".into(),
+                format!("{} fluids, at most {MAX_FLUIDS} are supported", self.fluids.len()),
+            ));
+        }
+        let materials = self.materials();
+        let known = || {
+            if materials.is_empty() {
+                "the case defines no fluid (give `eos` or `[fluid.fluids.<name>]`)".to_string()
+            } else {
+                let names: Vec<&str> = materials.iter().map(|m| m.name).collect();
+                format!("the case's fluids are: {}", names.join(", "))
+            }
+        };
+        let check = |field: String, name: &Option<String>| match name {
+            Some(n) if !materials.iter().any(|m| m.name == n) => {
+                Err((field, format!("unknown fluid `{n}`; {}", known())))
+            }
+            _ => Ok(()),
+        };
+        if let Some(init) = &self.initial {
+            check("fluid.initial.fluid".into(), &init.fluid)?;
+            if init.fluid.is_none() && materials.len() > 1 {
+                return Err((
+                    "fluid.initial.fluid".into(),
+                    format!(
+                        "missing: with several fluids the background needs one, e.g. fluid = \
+                         \"{}\"; {}",
+                        materials[0].name,
+                        known()
+                    ),
+                ));
+            }
+            for (k, r) in init.regions.iter().enumerate() {
+                check(format!("fluid.initial.regions[{k}].fluid"), &r.fluid)?;
+            }
+        }
+        Ok(())
+    }
+
     pub(crate) fn validate(&self) -> Result<(), (String, String)> {
+        self.validate_fluids()?;
         if let Some(p) = &self.piston {
             p.validate()?;
         }
@@ -446,3 +596,7 @@ impl FluidSection {
         Ok(())
     }
 }
+
+#[cfg(test)]
+#[path = "fluid_tests.rs"]
+mod tests;

@@ -1,0 +1,64 @@
+//! Edges between two fluids (thesis §3.3.2, Eq. 3.9; DESIGN §5): the two-phase ghost-fluid flux.
+//!
+//! At an edge `i -> j` whose end nodes hold different materials, the exact two-phase Riemann
+//! problem along `n̂ = ν_ij/|ν_ij|` between the nodal states `W_i` (EOS_i) and `W_j` (EOS_j)
+//! gives the star states on each side of the contact; each node then takes the single-material
+//! flux of the scheme between its own state and its side's star state, with its own EOS
+//! ([`crate::flux::two_phase_flux`]): `R_i += F(W_i, W*_i, EOS_i, ν_ij)` and
+//! `R_j -= F(W*_j, W_j, EOS_j, ν_ij)` (the j-side flux is along `+ν`, so it is subtracted as in
+//! the ordinary loop). No flux mixes the two EOS.
+//!
+//! The Riemann problem takes the nodal states, as in the thesis (Eq. 3.9 is initialised by
+//! `W_i` and `W_j`): the interface is first order. The two fluxes differ by the jump the contact
+//! carries, so the scheme is not conservative at the interface: `Σ_i R_i` equals the boundary flux
+//! plus `Σ (F_i - F_j)` over the two-material edges (zero for a contact at rest at equal
+//! pressure, whose two fluxes are both the pressure flux `p ν`).
+
+use crate::flux::two_phase_flux;
+use crate::mesh::blocks::Window;
+use crate::semidiscretization::{FluidError, Semidiscretization};
+use crate::special_edges::{SpecialEdge, SpecialKind};
+
+/// Adds the fluxes of the special edges `special` (of one block) to the residuals of their ends.
+pub(crate) fn special_fluxes(
+    semi: &Semidiscretization,
+    special: &[SpecialEdge],
+    prim: &[[f64; 5]],
+    r: &mut Window<'_, [f64; 5]>,
+) -> Result<(), FluidError> {
+    let mesh = &semi.mesh;
+    for s in special {
+        let e = s.edge as usize;
+        let [i, j] = mesh.edges[e];
+        let (i, j) = (i as usize, j as usize);
+        match s.kind {
+            SpecialKind::TwoMaterial => {
+                let f = two_phase_flux(
+                    semi.numerics.flux,
+                    semi.eos_at(i),
+                    &prim[i],
+                    semi.eos_at(j),
+                    &prim[j],
+                    &mesh.edge_normals[e],
+                )
+                .map_err(|error| {
+                    let m = semi.material();
+                    FluidError::TwoPhase {
+                        edge: e,
+                        nodes: [i, j],
+                        materials: [m[i], m[j]],
+                        position: mesh.coords[i],
+                        error,
+                    }
+                })?;
+                for k in 0..5 {
+                    r[i][k] += f.flux_i[k];
+                }
+                for k in 0..5 {
+                    r[j][k] -= f.flux_j[k];
+                }
+            }
+        }
+    }
+    Ok(())
+}
