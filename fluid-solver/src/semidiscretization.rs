@@ -35,6 +35,7 @@
 //!   stage.
 
 use crate::bc::BoundaryCondition;
+use crate::embedded::step::Wall;
 use crate::eos::{Eos, StateError};
 use crate::flux::{numerical_flux, FluxScheme};
 use crate::mesh::blocks::Window;
@@ -44,7 +45,7 @@ use crate::reconstruct::gradient::{LsqGradient, MirrorPlanes};
 use crate::reconstruct::limiter::Limiter;
 use crate::reconstruct::muscl;
 use crate::riemann::RiemannError;
-use crate::special_edges::SpecialEdges;
+use crate::special_edges::{SpecialEdges, SpecialKind};
 use crate::state::{MaterialId, Workspace};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -85,6 +86,10 @@ pub enum FluidError {
         position: [f64; 3],
         error: RiemannError,
     },
+    #[error("{0}")]
+    Wall(#[from] crate::embedded::riemann_fs::WallFluxError),
+    #[error("edge {edge} from active node {node} (x = {position:?}) to a node that is not active, not cut by the surface (taken as a slip wall): {error}")]
+    FrozenEdge { edge: usize, node: usize, position: [f64; 3], error: RiemannError },
 }
 
 /// The spatial operator: mesh, EOS table, material layout, scheme, gradient operator and
@@ -300,9 +305,24 @@ impl Semidiscretization {
         out: &mut [U],
         update: impl Fn(usize, &[f64; 5], &mut U) + Sync,
     ) -> Result<(), FluidError> {
+        self.residual_and_update_with(ws, out, update, None)
+    }
+
+    /// [`Semidiscretization::residual_and_update`] with an embedded boundary at a stage time
+    /// (thesis Ch. 4-5): its cut and frozen edges join the special edges of every block, and the
+    /// gradients skip them ([`crate::embedded::step`]). Nodes that are not active get a residual
+    /// too (from the edges they share with active nodes' blocks); the caller freezes them.
+    pub fn residual_and_update_with<U: Send>(
+        &self,
+        ws: &mut Workspace,
+        out: &mut [U],
+        update: impl Fn(usize, &[f64; 5], &mut U) + Sync,
+        wall: Option<Wall<'_>>,
+    ) -> Result<(), FluidError> {
         let mesh = &self.mesh;
         if self.numerics.second_order() {
-            self.gradient.compute(mesh, &ws.prim, &mut ws.grad);
+            let gradient = wall.map_or(&self.gradient, |w| &w.step.gradient);
+            gradient.compute(mesh, &ws.prim, &mut ws.grad);
         }
         let Workspace { prim, grad, residual, .. } = ws;
         let (prim, grad) = (&prim[..], &grad[..]);
@@ -311,7 +331,7 @@ impl Semidiscretization {
             for i in blocks.fresh(b) {
                 r[i] = [0.0; 5];
             }
-            self.block_fluxes(b, prim, grad, r)?;
+            self.block_fluxes(b, prim, grad, r, wall.as_ref())?;
             self.boundary_fluxes(blocks.nodes(b), prim, r)?;
             for i in blocks.completed(b) {
                 update(i, &r[i], &mut o[i]);
@@ -331,7 +351,7 @@ impl Semidiscretization {
             for i in blocks.fresh(b) {
                 r[i] = [0.0; 5];
             }
-            self.block_fluxes(b, prim, grad, r)
+            self.block_fluxes(b, prim, grad, r, None)
         })
     }
 
@@ -345,18 +365,35 @@ impl Semidiscretization {
         prim: &[[f64; 5]],
         grad: &[[[f64; 3]; 5]],
         r: &mut Window<'_, [f64; 5]>,
+        wall: Option<&Wall<'_>>,
     ) -> Result<(), FluidError> {
         let edges = self.mesh.blocks.edges(b);
-        if let Some(eos) = self.uniform_eos() {
+        let special = wall.map_or(&self.special, |w| &w.step.special);
+        let uniform = self.uniform_eos();
+        if let (Some(eos), true) = (uniform, special.block(b).is_empty()) {
             self.edge_fluxes(eos, edges, prim, grad, r);
             return Ok(());
         }
         let (table, material) = (&self.eos[..], &self.material[..]);
         let limiter = self.numerics.limiter;
-        for gap in self.special.gaps(b, edges) {
-            self.edge_loop(|i| table[material[i] as usize], limiter, gap, prim, grad, r);
+        for gap in special.gaps(b, edges) {
+            match uniform {
+                Some(eos) => self.edge_fluxes(eos, gap, prim, grad, r),
+                None => {
+                    self.edge_loop(|i| table[material[i] as usize], limiter, gap, prim, grad, r)
+                }
+            }
         }
-        crate::two_phase::special_fluxes(self, self.special.block(b), prim, r)
+        for &s in special.block(b) {
+            match (s.kind, wall) {
+                (SpecialKind::TwoMaterial, _) => {
+                    crate::two_phase::edge_flux(self, s.edge as usize, prim, r)?
+                }
+                (_, Some(w)) => w.edge_flux(self, s, prim, r)?,
+                (_, None) => unreachable!("cut and frozen edges come with their wall"),
+            }
+        }
+        Ok(())
     }
 
     /// Adds the fluxes of `edges` to the residuals of their end nodes, with the scheme's limiter,

@@ -13,6 +13,7 @@
 //! array and the node materials plus `(step, t)`, and the time step depends only on them, on the
 //! target time and on the output times after `t`.
 
+use crate::embedded::{self, advance::EmbeddedRun};
 use crate::output;
 use crate::probes::{Line, Placed};
 use crate::semidiscretization::Semidiscretization;
@@ -111,6 +112,8 @@ pub struct FluidRun<'a> {
     bar: Option<Progress>,
     /// `Err` once a step failed: the run stops there and reports it.
     status: Result<(), String>,
+    /// The embedded surface of `[fluid.embedded]` (fluid-alone runs).
+    embedded: Option<EmbeddedRun>,
 }
 
 impl<'a> FluidRun<'a> {
@@ -158,6 +161,19 @@ impl<'a> FluidRun<'a> {
         }
         let mut ws = Workspace::new(semi.mesh.n_nodes());
         semi.primitives(&state.cons, &mut ws)?;
+        let embedded = match embedded::case::prescribed(case, &semi.mesh, t)? {
+            None => None,
+            Some(_) if mode == Mode::Coupled => anyhow::bail!(
+                "[fluid.embedded] prescribes the surface of a fluid-alone run; a coupled run takes its surface from the structure"
+            ),
+            Some(_) if opts.restart.is_some() => anyhow::bail!(
+                "a run with [fluid.embedded] cannot restart yet: its node status is not in the checkpoints; run it from the start"
+            ),
+            Some(p) => {
+                let p_cut = case.fluid.as_ref().and_then(|f| f.embedded.as_ref()).and_then(|e| e.p_cut);
+                Some(EmbeddedRun::new(p, p_cut, out.path())?)
+            }
+        };
 
         let mut fields = output::create_writer(out.path(), &semi.mesh)?;
         let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
@@ -186,6 +202,7 @@ impl<'a> FluidRun<'a> {
             last_fields_step: step,
             bar: Some(bar),
             status: Ok(()),
+            embedded,
         };
         run.write_probes()?;
         // Lines asked for at the start time.
@@ -256,8 +273,21 @@ impl<'a> FluidRun<'a> {
             let (step, t) = (self.step, self.t);
             let stop = self.next_stop(t_target);
             let start = Instant::now();
-            let result =
-                rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, stop - t);
+            let result = match &mut self.embedded {
+                None => {
+                    rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, stop - t)
+                        .map_err(anyhow::Error::from)
+                }
+                Some(e) => {
+                    let (tracking, loads) = (e.tracking_s, e.loads_s);
+                    let cfl = self.stepping.cfl();
+                    let r = e.step(&self.semi, &mut self.state, &mut self.ws, cfl, t, stop - t);
+                    let d = |s: f64| std::time::Duration::from_secs_f64(s.max(0.0));
+                    self.timers.add(bucket::TRACKING, d(e.tracking_s - tracking));
+                    self.timers.add(bucket::LOADS, d(e.loads_s - loads));
+                    r
+                }
+            };
             self.timers.add_since(bucket::RESIDUAL, start);
             let dt = match result {
                 Ok(dt) => dt,
@@ -358,6 +388,9 @@ impl<'a> FluidRun<'a> {
             }
         }
         self.probe_csv.flush()?;
+        if let Some(e) = &mut self.embedded {
+            e.flush()?;
+        }
         self.fields.finish()?;
         if self.mode == Mode::Alone {
             write_report(

@@ -23,6 +23,11 @@ use std::ops::Range;
 pub enum SpecialKind {
     /// Its end nodes hold different fluids: the two-phase ghost-fluid flux (thesis Eq. 3.9).
     TwoMaterial = 0,
+    /// Not cut by the embedded surface, but one end is not an active fluid node: the active end
+    /// sees a slip wall on the edge's facet (a fallback the tracking should leave no room for).
+    Frozen = 1,
+    /// Cut by the embedded surface: Alg. 5.1 for each active end, whatever the fluids.
+    Cut = 2,
 }
 
 /// One special edge: its index in `mesh.edges` and its kind.

@@ -17,48 +17,41 @@
 use crate::flux::two_phase_flux;
 use crate::mesh::blocks::Window;
 use crate::semidiscretization::{FluidError, Semidiscretization};
-use crate::special_edges::{SpecialEdge, SpecialKind};
 
-/// Adds the fluxes of the special edges `special` (of one block) to the residuals of their ends.
-pub(crate) fn special_fluxes(
+/// Adds the two-phase fluxes of edge `e` (its ends hold different materials) to the residuals of
+/// its ends.
+pub(crate) fn edge_flux(
     semi: &Semidiscretization,
-    special: &[SpecialEdge],
+    e: usize,
     prim: &[[f64; 5]],
     r: &mut Window<'_, [f64; 5]>,
 ) -> Result<(), FluidError> {
     let mesh = &semi.mesh;
-    for s in special {
-        let e = s.edge as usize;
-        let [i, j] = mesh.edges[e];
-        let (i, j) = (i as usize, j as usize);
-        match s.kind {
-            SpecialKind::TwoMaterial => {
-                let f = two_phase_flux(
-                    semi.numerics.flux,
-                    semi.eos_at(i),
-                    &prim[i],
-                    semi.eos_at(j),
-                    &prim[j],
-                    &mesh.edge_normals[e],
-                )
-                .map_err(|error| {
-                    let m = semi.material();
-                    FluidError::TwoPhase {
-                        edge: e,
-                        nodes: [i, j],
-                        materials: [m[i], m[j]],
-                        position: mesh.coords[i],
-                        error,
-                    }
-                })?;
-                for k in 0..5 {
-                    r[i][k] += f.flux_i[k];
-                }
-                for k in 0..5 {
-                    r[j][k] -= f.flux_j[k];
-                }
-            }
+    let [i, j] = mesh.edges[e];
+    let (i, j) = (i as usize, j as usize);
+    let f = two_phase_flux(
+        semi.numerics.flux,
+        semi.eos_at(i),
+        &prim[i],
+        semi.eos_at(j),
+        &prim[j],
+        &mesh.edge_normals[e],
+    )
+    .map_err(|error| {
+        let m = semi.material();
+        FluidError::TwoPhase {
+            edge: e,
+            nodes: [i, j],
+            materials: [m[i], m[j]],
+            position: mesh.coords[i],
+            error,
         }
+    })?;
+    for k in 0..5 {
+        r[i][k] += f.flux_i[k];
+    }
+    for k in 0..5 {
+        r[j][k] -= f.flux_j[k];
     }
     Ok(())
 }

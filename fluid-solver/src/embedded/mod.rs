@@ -9,6 +9,7 @@
 //! read-only view with the stage time; `Semidiscretization` never owns the surface.
 
 pub mod adjacency;
+pub mod advance;
 pub mod bvh;
 pub mod case;
 pub mod fill;
@@ -20,6 +21,7 @@ pub mod predicates;
 pub mod read;
 pub mod riemann_fs;
 pub mod status;
+pub mod step;
 pub mod surface;
 #[cfg(test)]
 pub(crate) mod test_cuts;

@@ -36,7 +36,7 @@ pub struct LoadView<'a> {
     pub mesh: &'a Mesh,
     pub surface: &'a Surface,
     pub t: f64,
-    pub side: &'a [i8],
+    pub side: &'a [u32],
     pub cuts: &'a [CutEdge],
     pub p_star: &'a [WallPressures],
 }

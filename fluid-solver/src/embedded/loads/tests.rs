@@ -103,7 +103,7 @@ fn load(
     p_star: &[[f64; 2]],
     centre: [f64; 3],
 ) -> Loaded {
-    let side: Vec<i8> = outer.iter().map(|&o| o as i8).collect();
+    let side: Vec<u32> = outer.iter().map(|&o| o as u32).collect();
     let view = LoadView { mesh, surface: s, t: 0.0, side: &side, cuts, p_star };
     let mut out = vec![[0.0; 3]; s.n_nodes()];
     nodal_loads(algorithm, &view, &mut out).unwrap();
@@ -346,7 +346,7 @@ fn closed_surface_residuals(
     }
     let [l3, l4] = [LoadAlgorithm::Reconstructed, LoadAlgorithm::Facets]
         .map(|a| load(a, &mesh, s, &cuts, &outer, &p_star, centre));
-    let side: Vec<i8> = outer.iter().map(|&o| o as i8).collect();
+    let side: Vec<u32> = outer.iter().map(|&o| o as u32).collect();
     let view =
         LoadView { mesh: &mesh, surface: s, t: 0.0, side: &side, cuts: &cuts, p_star: &p_star };
     let mut m = [0.0; 3];
@@ -504,7 +504,7 @@ fn bad_inputs_are_named() {
     let s = ribbon(-1.0, 2.0);
     let cuts = brute_force_cuts(&mesh, &s, 0.0);
     let p = vec![[1.0, f64::NAN]; cuts.len()];
-    let side = vec![0i8; mesh.n_nodes()];
+    let side = vec![0u32; mesh.n_nodes()];
     let view = LoadView { mesh: &mesh, surface: &s, t: 0.0, side: &side, cuts: &cuts, p_star: &p };
     let mut out = vec![[0.0; 3]; 3];
     let err = nodal_loads(LoadAlgorithm::Facets, &view, &mut out).unwrap_err();

@@ -1,0 +1,94 @@
+//! Embedded-boundary cases run alone (thesis Ch. 4-5, DESIGN §8.3): `cases/piston-air`, a wall
+//! that the grid does not fit pushing air at 10 m/s, against the exact piston solution on three
+//! meshes: the shock speed, `p - p0` and `ρ - ρ0` (the jumps, 4% of the state) each within 1% on
+//! the finest, the errors falling with the mesh, and the force on the wall equal to `p* A`.
+
+use fluid_solver::eos::Eos;
+use fluid_solver::riemann::{RiemannSolution, State1d};
+use fluid_solver::solver::{self, RunOptions};
+use interface_protocol::case::Case;
+use std::path::{Path, PathBuf};
+
+fn case_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../cases/piston-air/case.toml")
+}
+
+/// Columns of a CSV file by name.
+fn columns(path: &Path) -> std::collections::HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    for l in lines {
+        for (c, v) in cols.iter_mut().zip(l.split(',')) {
+            c.push(v.parse().unwrap());
+        }
+    }
+    names.into_iter().zip(cols).collect()
+}
+
+/// The piston problem's exact jumps: (shock speed, p* - p0, ρ* - ρ0). The air lies right of a wall
+/// moving at +10 m/s: the mirror image of air left of a wall at -10 m/s.
+fn exact() -> (f64, f64, f64) {
+    let eos = Eos::PerfectGas { gamma: 1.4 };
+    let s = RiemannSolution::wall(&eos, State1d { rho: 1.3, u: 0.0, p: 1e5 }, -10.0).unwrap();
+    let (head, _) = s.left_wave();
+    (-head, s.star.p - 1e5, s.star.rho_l - 1.3)
+}
+
+struct Measured {
+    speed: f64,
+    dp: f64,
+    drho: f64,
+    force: f64,
+}
+
+/// Runs the case on `cells` cells along the tube and measures the plateau (x in [0.05, 0.3]) and
+/// the shock position (where p crosses half the jump) at t = 1.2 ms.
+fn run(cells: usize, out: &Path) -> Measured {
+    let overrides =
+        vec![format!("fluid.mesh.box.cells=[{cells},1,1]"), "output.fields_every=0".to_string()];
+    let case = Case::load(&case_path(), &overrides).unwrap();
+    let text = std::fs::read_to_string(case_path()).unwrap();
+    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: false };
+    solver::run(&case, &text, &opts).unwrap();
+    let line = columns(&out.join("lines/axis_t1.200000e-3.csv"));
+    let (x, p, rho) = (&line["x"], &line["p"], &line["rho"]);
+    let plateau: Vec<usize> = (0..x.len()).filter(|&k| x[k] > 0.05 && x[k] < 0.3).collect();
+    let mean = |v: &[f64]| plateau.iter().map(|&k| v[k]).sum::<f64>() / plateau.len() as f64;
+    let (dp, drho) = (mean(p) - 1e5, mean(rho) - 1.3);
+    let half = 1e5 + 0.5 * dp;
+    let k = (0..x.len() - 1).find(|&k| x[k] > 0.1 && p[k] >= half && p[k + 1] < half).unwrap();
+    let xs = x[k] + (half - p[k]) / (p[k + 1] - p[k]) * (x[k + 1] - x[k]);
+    let forces = columns(&out.join("surface_forces.csv"));
+    let force = *forces["surface.fx"].last().unwrap();
+    Measured { speed: (xs - 0.001) / 1.2e-3, dp, drho, force }
+}
+
+#[test]
+fn piston_air_matches_the_exact_shock_on_three_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (speed, dp, drho) = exact();
+    assert!((speed - 334.2).abs() < 0.1 && (dp - 4345.0).abs() < 1.0, "{speed} {dp}");
+    let mut errors = Vec::new();
+    for cells in [65, 130, 260] {
+        let m = run(cells, &dir.path().join(format!("n{cells}")));
+        let e = [(m.speed - speed) / speed, (m.dp - dp) / dp, (m.drho - drho) / drho];
+        println!(
+            "{cells} cells: shock {:.2} m/s, p - p0 {:.1} Pa, ρ - ρ0 {:.5}: relative errors {e:?}",
+            m.speed, m.dp, m.drho
+        );
+        // The wall's load is the wall pressure on the tube's section, pushing it back.
+        let area = 0.01 * 0.01;
+        assert!(
+            (m.force + (1e5 + m.dp) * area).abs() < 1e-3 * (1e5 + m.dp) * area,
+            "force {}",
+            m.force
+        );
+        errors.push(e);
+    }
+    let finest = errors.last().unwrap();
+    assert!(finest.iter().all(|e| e.abs() < 0.01), "finest mesh: {finest:?}");
+    let (coarse, fine) = (errors[0][0].abs(), finest[0].abs());
+    assert!(fine < coarse, "the shock speed error must fall with h: {coarse} -> {fine}");
+}
