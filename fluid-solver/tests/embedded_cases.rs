@@ -1,16 +1,29 @@
-//! Embedded-boundary cases run alone (thesis Ch. 4-5, DESIGN §8.3): `cases/piston-air`, a wall
-//! that the grid does not fit pushing air at 10 m/s, against the exact piston solution on three
-//! meshes: the shock speed, `p - p0` and `ρ - ρ0` (the jumps, 4% of the state) each within 1% on
-//! the finest, the errors falling with the mesh, and the force on the wall equal to `p* A`.
+//! Embedded-boundary cases run alone (thesis Ch. 4-5, DESIGN §8.3 and §8.5):
+//! - `cases/piston-air`, a wall that the grid does not fit pushing air at 10 m/s, against the
+//!   exact piston solution on three meshes: the shock speed, `p - p0` and `ρ - ρ0` (the jumps,
+//!   4% of the state) each within 1% on the finest, and the force on the wall equal to `p* A`;
+//! - `cases/harmonic-body`, the thesis' body in harmonic motion, against the exact simple wave on
+//!   four meshes: L1, L2 and Linf pressure errors, their orders, and a committed table.
+
+mod common;
 
 use fluid_solver::eos::Eos;
+use fluid_solver::riemann::simple_wave::SimpleWave;
 use fluid_solver::riemann::{RiemannSolution, State1d};
 use fluid_solver::solver::{self, RunOptions};
 use interface_protocol::case::Case;
 use std::path::{Path, PathBuf};
 
-fn case_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../cases/piston-air/case.toml")
+fn case_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../cases/{name}/case.toml"))
+}
+
+/// Runs case `name` with `overrides` into `out`.
+fn run_case(name: &str, overrides: &[String], out: &Path) {
+    let case = Case::load(&case_path(name), overrides).unwrap();
+    let text = std::fs::read_to_string(case_path(name)).unwrap();
+    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: false };
+    solver::run(&case, &text, &opts).unwrap();
 }
 
 /// Columns of a CSV file by name.
@@ -48,10 +61,7 @@ struct Measured {
 fn run(cells: usize, out: &Path) -> Measured {
     let overrides =
         vec![format!("fluid.mesh.box.cells=[{cells},1,1]"), "output.fields_every=0".to_string()];
-    let case = Case::load(&case_path(), &overrides).unwrap();
-    let text = std::fs::read_to_string(case_path()).unwrap();
-    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: false };
-    solver::run(&case, &text, &opts).unwrap();
+    run_case("piston-air", &overrides, out);
     let line = columns(&out.join("lines/axis_t1.200000e-3.csv"));
     let (x, p, rho) = (&line["x"], &line["p"], &line["rho"]);
     let plateau: Vec<usize> = (0..x.len()).filter(|&k| x[k] > 0.05 && x[k] < 0.3).collect();
@@ -91,4 +101,50 @@ fn piston_air_matches_the_exact_shock_on_three_meshes() {
     assert!(finest.iter().all(|e| e.abs() < 0.01), "finest mesh: {finest:?}");
     let (coarse, fine) = (errors[0][0].abs(), finest[0].abs());
     assert!(fine < coarse, "the shock speed error must fall with h: {coarse} -> {fine}");
+}
+
+/// Thesis §5.2.3.3 on 80, 160, 320 and 640 cells (limiter on): pressure errors over the fluid at
+/// t = 0.01 (line samples left of the body, one cell clear of it) against the exact simple wave.
+/// The interface of Alg. 5.1 is first order (node states, the wall at the node's facet), and the
+/// observed orders show it: about 1.1 in L1 and L2 and 1.0-1.3 in Linf, where the thesis reports
+/// 1.46 / 1.40 / 1.10 against its finest mesh. The gate here is order >= 1 in every norm, with the
+/// table committed; the 1.4 in L1 of a second-order interface is not reached.
+#[test]
+fn harmonic_body_converges_to_the_exact_simple_wave() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r, w) = (0.08, std::f64::consts::TAU * 100.0);
+    let piston = move |t: f64| (r * (1.0 - (w * t).cos()), r * w * (w * t).sin());
+    let wave = SimpleWave { piston, gamma: 1.4, rho0: 1.3, p0: 1e5 };
+    let cells = [80usize, 160, 320, 640];
+    let mut norms = Vec::new();
+    for &n in &cells {
+        let out = dir.path().join(format!("n{n}"));
+        run_case("harmonic-body", &[format!("fluid.mesh.box.cells=[{n},1,1]")], &out);
+        let line = columns(&out.join("lines/axis_t1.000000e-2.csv"));
+        let h = 4.5 / n as f64;
+        let errors: Vec<f64> = (0..line["x"].len())
+            .filter(|&k| line["x"][k] < -h)
+            .map(|k| (line["p"][k] - wave.state(line["x"][k], 0.01).unwrap().2).abs())
+            .collect();
+        let m = errors.len() as f64;
+        let l1 = errors.iter().sum::<f64>() / m;
+        let l2 = (errors.iter().map(|e| e * e).sum::<f64>() / m).sqrt();
+        let linf = errors.iter().copied().fold(0.0, f64::max);
+        println!("{n} cells: pressure errors L1 {l1:.2} Pa, L2 {l2:.2} Pa, Linf {linf:.1} Pa");
+        norms.push([l1, l2, linf]);
+    }
+    // Least-squares slope of log(error) against log(h) over the four meshes.
+    let fit = |k: usize| {
+        let pts: Vec<(f64, f64)> =
+            cells.iter().zip(&norms).map(|(&n, e)| ((4.5 / n as f64).ln(), e[k].ln())).collect();
+        let (mx, my) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 / 4.0, a.1 + p.1 / 4.0));
+        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        sxy / sxx
+    };
+    let orders = [fit(0), fit(1), fit(2)];
+    println!("fitted orders L1 {:.2}, L2 {:.2}, Linf {:.2}", orders[0], orders[1], orders[2]);
+    assert!(orders.iter().all(|&o| o >= 1.0), "orders {orders:?}");
+    let table = serde_json::json!({ "cells": cells, "l1_l2_linf_pa": norms, "orders": orders });
+    common::compare_with_reference("harmonic_body.json", &table, 0.05);
 }
