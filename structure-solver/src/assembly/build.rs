@@ -4,6 +4,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::stable_step::{characteristic_length, ElementBound};
 use super::{gather, AssemblyError, Bt4Part, FeModel, Part, State};
 use crate::elements::bt4::{Bt4, Bt4Settings};
 use crate::elements::{Element, ElementKind, RotaryInertia};
@@ -96,7 +97,7 @@ impl FeModel {
             };
             Bt4Part {
                 shells: Bt4::new(bt4_conn, bt4_h, material, settings),
-                x: vec![[0.0; 3]; nn],
+                x: x0.iter().map(|p| [p.x, p.y, p.z]).collect(),
                 du: vec![0.0; 6 * nn],
                 evaluated: false,
             }
@@ -135,9 +136,12 @@ impl FeModel {
             prescribed: vec![],
             point_loads: vec![],
             pressures: vec![],
+            face_pressures: vec![],
             gravity: None,
             external: vec![0.0; 6 * nn],
-            dt_crit: 0.0,
+            held_extra: vec![],
+            scratch: vec![],
+            element_bound: vec![],
         };
         m.set_rotary_inertia(RotaryInertia::Physical);
         Ok(m)
@@ -162,7 +166,7 @@ impl FeModel {
     pub fn set_rotary_inertia(&mut self, rotary: RotaryInertia) {
         self.rotary = rotary;
         let mut mass = vec![0.0; self.x0.len() * 6];
-        let mut w2max = 0.0f64;
+        let mut bound = Vec::with_capacity(self.elements.len());
         for e in &self.elements {
             let me = self.element_mass(e);
             for (i, &n) in e.nodes.iter().enumerate() {
@@ -171,14 +175,15 @@ impl FeModel {
                 }
             }
             let x = gather(&self.x0, &e.nodes);
-            w2max = w2max.max(e.max_frequency_squared(&x, &me));
+            let w2 = e.max_frequency_squared(&x, &me);
+            let dt = if w2 > 0.0 { 2.0 / w2.sqrt() } else { f64::INFINITY };
+            bound.push(ElementBound { dt, length: characteristic_length(e.kind, &x) });
         }
-        self.dt_crit = if w2max > 0.0 { 2.0 / w2max.sqrt() } else { f64::INFINITY };
+        self.element_bound = bound;
         if let Some(b) = &mut self.bt4 {
             b.shells.settings.rotary = rotary;
             let x0: Vec<[f64; 3]> = self.x0.iter().map(|p| [p.x, p.y, p.z]).collect();
             b.shells.lumped_mass(&x0, &mut mass);
-            self.dt_crit = self.dt_crit.min(b.shells.stable_dt(&x0));
         }
         self.node_mass = mass;
         self.reduce_mass();

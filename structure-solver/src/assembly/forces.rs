@@ -67,37 +67,7 @@ impl Model for FeModel {
 
     fn internal_force(&mut self, f: &mut [f64]) {
         f.fill(0.0);
-        let s = &mut self.trial;
-        let committed = &self.committed.material;
-        // Each element's slice of the trial state, for the parallel loop.
-        let mut trial_states = Vec::with_capacity(self.elements.len());
-        let mut rest = s.material.as_mut_slice();
-        for w in self.state_offsets.windows(2) {
-            let (mine, tail) = rest.split_at_mut(w[1] - w[0]);
-            trial_states.push(mine);
-            rest = tail;
-        }
-        let (x, r) = (&s.x, &s.r);
-        let offsets = &self.state_offsets;
-        let parts: Vec<Vec<f64>> = self
-            .elements
-            .par_iter()
-            .zip(trial_states.into_par_iter())
-            .enumerate()
-            .map(|(ei, (e, new))| {
-                let mut fe = vec![0.0; 6 * e.nodes.len()];
-                let old = &committed[offsets[ei]..offsets[ei + 1]];
-                e.force(&gather(x, &e.nodes), &gather(r, &e.nodes), old, new, &mut fe);
-                fe
-            })
-            .collect();
-        for (e, fe) in self.elements.iter().zip(&parts) {
-            for (i, &n) in e.nodes.iter().enumerate() {
-                for c in 0..6 {
-                    f[6 * n + c] += fe[6 * i + c];
-                }
-            }
-        }
+        self.element_forces(f);
         if let Some(b) = &mut self.bt4 {
             // BT4 reads the end positions and the step's increment (translations and summed
             // spins since the last commit).
@@ -120,6 +90,13 @@ impl Model for FeModel {
     }
 
     fn external_force(&mut self, t: f64, f: &mut [f64]) {
+        self.external_force_with(t, None, f);
+    }
+
+    /// Every load (the case's, the coupling's `extra`) gathered per node, then reduced once:
+    /// skew-plane nodes to their plane, rigid slaves to their master.
+    fn external_force_with(&mut self, t: f64, extra: Option<&[f64]>, f: &mut [f64]) {
+        self.hold_extra(extra);
         self.external_unreduced(t, f);
         self.reduce_skew_forces(f);
         if self.rigid.is_empty() {
@@ -289,7 +266,7 @@ impl Model for FeModel {
     }
 
     fn stable_dt(&self) -> f64 {
-        self.dt_crit
+        self.current_stable_dt()
     }
 
     fn displacement(&self, out: &mut [[f64; 3]]) {

@@ -1,9 +1,10 @@
-//! Loads: time curves, point loads, gravity, follower pressure on shells and the external
-//! nodal array the coupling fills; all of them gathered unreduced per node.
+//! Loads: time curves, point loads, gravity, follower pressure on shells and on the boundary
+//! faces of solids, and the external nodal array the coupling fills; all of them gathered
+//! unreduced per node, then reduced once by the constraints (`forces`).
 
 use nalgebra::Vector3;
 
-use super::{gather, FeModel};
+use super::{AssemblyError, FeModel};
 
 /// A scalar function of time multiplying a load or a prescribed value.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,6 +58,24 @@ impl FeModel {
         self.gravity = Some((g, curve));
     }
 
+    /// Follower pressure `p · curve(t)` on boundary faces of solids: each face `[a, b, c]`
+    /// counter-clockwise seen from outside (`wet::tet_boundary` orders them so), pushed
+    /// into the solid by `-p A n` shared equally by its three nodes, `A n` its current
+    /// area vector. Faces naming a node outside the model are refused.
+    pub fn face_pressure(
+        &mut self,
+        faces: &[[usize; 3]],
+        p: f64,
+        curve: Curve,
+    ) -> Result<(), AssemblyError> {
+        let nn = self.x0.len();
+        if let Some(&node) = faces.iter().flatten().find(|&&n| n >= nn) {
+            return Err(AssemblyError::NodeRange { node, n: nn });
+        }
+        self.face_pressures.push((faces.to_vec(), p, curve));
+        Ok(())
+    }
+
     /// The external nodal load array (6 per node) the coupled participant fills; added to the
     /// external force at every `t` as it is.
     pub fn external_loads_mut(&mut self) -> &mut [f64] {
@@ -75,9 +94,22 @@ impl FeModel {
         p
     }
 
-    /// External force before the rigid reduction (loads on every node as given).
+    /// Keeps the nodal load from outside the model for the external forces that follow
+    /// (`None`: there is none).
+    pub(super) fn hold_extra(&mut self, extra: Option<&[f64]>) {
+        self.held_extra.clear();
+        if let Some(x) = extra {
+            self.held_extra.extend_from_slice(x);
+        }
+    }
+
+    /// External force before the rigid and skew reduction (loads on every node as given,
+    /// the held load from outside the model included).
     pub(super) fn external_unreduced(&self, t: f64, f: &mut [f64]) {
         f.copy_from_slice(&self.external);
+        for (f, x) in f.iter_mut().zip(&self.held_extra) {
+            *f += x;
+        }
         for (d, v, c) in &self.point_loads {
             f[*d] += v * c.at(t);
         }
@@ -89,15 +121,33 @@ impl FeModel {
                 }
             }
         }
-        let pc = self.cell_pressure(t);
-        let mut fe = [0.0; 24];
+        let pc = if self.pressures.is_empty() { vec![] } else { self.cell_pressure(t) };
+        let (mut fe, mut xe) = ([0.0; 24], [Vector3::zeros(); 4]);
         for (p, nodes) in pc.iter().zip(&self.cells) {
             if *p != 0.0 {
                 let k = nodes.len();
-                pressure_force(*p, &gather(&self.trial.x, nodes), &mut fe[..6 * k]);
+                for (x, &n) in xe.iter_mut().zip(nodes) {
+                    *x = self.trial.x[n];
+                }
+                pressure_force(*p, &xe[..k], &mut fe[..6 * k]);
                 for (i, &n) in nodes.iter().enumerate() {
                     for c in 0..3 {
                         f[6 * n + c] += fe[6 * i + c];
+                    }
+                }
+            }
+        }
+        let x = &self.trial.x;
+        for (faces, p, c) in &self.face_pressures {
+            let s = p * c.at(t) / 3.0;
+            if s == 0.0 {
+                continue;
+            }
+            for &[a, b, d] in faces {
+                let push = -0.5 * s * (x[b] - x[a]).cross(&(x[d] - x[a]));
+                for n in [a, b, d] {
+                    for k in 0..3 {
+                        f[6 * n + k] += push[k];
                     }
                 }
             }

@@ -4,7 +4,8 @@
 //! prescribed and skew-symmetry dofs and their reduction), `rigid_bodies` (rigid bodies and
 //! links: slaves on masters, the reduction `Tᵀ f`, `Tᵀ K T`), `loads` (time curves, point
 //! loads, pressure, gravity, the coupling's nodal array), `forces` (the `Model` the
-//! integrators call), `state` (the committed state checkpoints hold).
+//! integrators call; `element_forces` its element loop), `stable_step` (the element bound of the critical step at the current
+//! configuration), `state` (the committed state checkpoints hold).
 //!
 //! Six dofs per node `[ux, uy, uz, θx, θy, θz]`; rotations are stored as matrices and updated
 //! by spatial spins, `R ← exp([δθ]×) R`. Constraints: fixed dofs, symmetry planes normal to a
@@ -27,9 +28,11 @@
 
 mod build;
 mod constraints;
+mod element_forces;
 mod forces;
 mod loads;
 mod rigid_bodies;
+mod stable_step;
 mod state;
 
 use nalgebra::{Matrix3, Vector3};
@@ -125,9 +128,17 @@ pub struct FeModel {
     prescribed: Vec<(usize, f64, Curve)>,
     point_loads: Vec<(usize, f64, Curve)>,
     pressures: Vec<(Vec<usize>, f64, Curve)>,
+    /// Pressures on boundary faces of solids (outward counter-clockwise triangles).
+    face_pressures: Vec<(Vec<[usize; 3]>, f64, Curve)>,
     gravity: Option<([f64; 3], Curve)>,
     external: Vec<f64>,
-    dt_crit: f64,
+    /// The nodal load from outside the model given with the last external force
+    /// (`Model::external_force_with`; empty: none), reduced with the model's own loads.
+    held_extra: Vec<f64>,
+    /// Work arrays of the element force loop.
+    scratch: Vec<element_forces::ElementScratch>,
+    /// Each element's bound of the critical step at the reference configuration.
+    element_bound: Vec<stable_step::ElementBound>,
 }
 
 /// The BT4 shells of a model with their work arrays.

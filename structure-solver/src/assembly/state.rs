@@ -37,6 +37,10 @@ impl FeModel {
                 }
                 b.shells.set_state(s);
                 b.evaluated = false;
+                // the configuration the shells' stable step reads
+                for (b, p) in b.x.iter_mut().zip(x) {
+                    *b = [p.x, p.y, p.z];
+                }
             }
             (None, None) => {}
             (Some(_), None) => return Err("the model has BT4 shells, the state has none".into()),

@@ -2,10 +2,11 @@
 
 use std::time::Instant;
 
-use anyhow::{anyhow, Context};
+use anyhow::{anyhow, bail, Context};
 use interface_protocol::case::Integrator;
 use interface_protocol::io::outdir::OutputDir;
 use interface_protocol::io::report::{bucket, Timers};
+use interface_protocol::resources::MAX_STEPS;
 
 use super::alone_output::AloneOutput;
 use super::checkpoint::{write_checkpoint, Resume};
@@ -15,7 +16,7 @@ use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::prepare::unstable_note;
 use crate::state_check::check_state;
-use crate::time::{CentralDifference, Dynamics, Implicit, ImplicitScheme};
+use crate::time::{CentralDifference, Dynamics, Implicit, ImplicitScheme, StableStep};
 
 /// A dynamic run alone: central differences or an implicit scheme stepping to `t_end`, each
 /// step checked finite (naming step, time, node and dof, and an unstable step) before its
@@ -27,6 +28,8 @@ pub(super) struct Dynamic<'a> {
     pub(super) t_end: f64,
     pub(super) dt: f64,
     pub(super) stable: Option<f64>,
+    /// Central differences: the step recomputed every step (`dt` and `stable` then follow it).
+    pub(super) adaptive: Option<StableStep>,
     pub(super) output: &'a mut AloneOutput,
     pub(super) timers: &'a mut Timers,
     pub(super) reached: &'a mut Reached,
@@ -51,7 +54,10 @@ impl Dynamic<'_> {
             let (at, last) = ((self.reached.steps, cd.state.t, dt), self.ended(cd.state.t));
             self.output.write(model, Some(model), &cd.state.v, at, last)?;
             while !self.ended(cd.state.t) {
-                let step = dt.min(t_end - cd.state.t);
+                if let Some(rule) = self.adaptive {
+                    self.adapt(rule.at(model), rule.safety)?;
+                }
+                let step = self.dt.min(t_end - cd.state.t);
                 self.timers.time(bucket::STRUCTURE, || cd.step(model, step, None));
                 let state = (&cd.state.v[..], &cd.state.a[..], Some(cd.internal_force()));
                 self.finite(model, &mut disp, state, cd.state.t)?;
@@ -99,6 +105,24 @@ impl Dynamic<'_> {
                 self.reached.steps + 1
             )
         })
+    }
+
+    /// Takes the stable step `dt` of the current configuration (`safety` x the stable one),
+    /// refusing one that is no longer a positive number or a run past `MAX_STEPS` steps.
+    fn adapt(&mut self, dt: f64, safety: f64) -> anyhow::Result<()> {
+        let n = self.reached.steps + 1;
+        if !(dt.is_finite() && dt > 0.0) {
+            bail!(
+                "step {n}: the stable step at the current configuration is {dt:e} s: an element \
+                 has collapsed"
+            );
+        }
+        if n > MAX_STEPS {
+            bail!("step {n}: more than {MAX_STEPS} steps; the stable step has fallen to {dt:e} s");
+        }
+        self.dt = dt;
+        self.stable = Some(dt / safety);
+        Ok(())
     }
 
     /// Whether `t` is the end of the run.

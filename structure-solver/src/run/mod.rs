@@ -80,7 +80,7 @@ pub fn run(opts: &RunOptions) -> anyhow::Result<RunSummary> {
     if statics && opts.restart.is_some() {
         bail!("--restart applies to dynamic runs; a static run starts from its unloaded state");
     }
-    let Alone { structure, integrator, t_end, stable, probe_nodes, .. } = alone;
+    let Alone { structure, integrator, t_end, stable, adaptive, probe_nodes, .. } = alone;
     let Structure { mesh, mut model, v0, cells, .. } = structure;
     let n = mesh.nodes.len();
 
@@ -126,6 +126,7 @@ pub fn run(opts: &RunOptions) -> anyhow::Result<RunSummary> {
                 t_end,
                 dt,
                 stable,
+                adaptive,
                 output: &mut output,
                 timers: &mut timers,
                 reached: &mut reached,
