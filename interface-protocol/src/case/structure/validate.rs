@@ -260,8 +260,8 @@ impl StructureSection {
                 for (i, row) in j.iter().enumerate() {
                     finite(&format!("{f}.inertia[{i}]"), row)?;
                 }
-                let asym = (0..3).flat_map(|i| (0..3).map(move |k| (i, k)));
-                if let Some((i, k)) = asym.into_iter().find(|&(i, k)| j[i][k] != j[k][i]) {
+                let mut asym = (0..3).flat_map(|i| (0..3).map(move |k| (i, k)));
+                if let Some((i, k)) = asym.find(|&(i, k)| j[i][k] != j[k][i]) {
                     return Err((
                         format!("{f}.inertia"),
                         format!(
