@@ -18,6 +18,7 @@ use crate::mesh::{validate, CellKind, Mesh};
 use crate::model::Model;
 use crate::output::CellMap;
 use crate::rigid::{ExtraMass, RigidReference};
+use crate::wet::tet_boundary;
 
 pub(crate) fn need<'a, T>(v: &'a Option<T>, field: &str, case: &Case) -> anyhow::Result<&'a T> {
     v.as_ref().ok_or_else(|| {
@@ -308,21 +309,40 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
     for (k, rb) in s.rigid_bodies.iter().enumerate() {
         let f = format!("structure.rigid_bodies[{k}]");
         let nodes = node_set(&mesh, &rb.set, &format!("{f}.set"), case)?;
-        let reference = match rb.reference {
-            Some(p) => RigidReference::Point(p),
-            None => RigidReference::MassCentre,
+        let reference = match (rb.reference, &rb.reference_set) {
+            (Some(p), _) => RigidReference::Point(p),
+            (None, Some(name)) => {
+                let field = format!("{f}.reference_set");
+                match node_set(&mesh, name, &field, case)?[..] {
+                    [n] => RigidReference::Node(n),
+                    ref other => {
+                        return Err(field_error(
+                            case,
+                            &field,
+                            format!("expected a set of one node, \"{name}\" holds {}", other.len()),
+                        ))
+                    }
+                }
+            }
+            (None, None) => RigidReference::MassCentre,
         };
-        let extra = ExtraMass { mass: rb.mass, ..ExtraMass::default() };
+        let extra = ExtraMass {
+            mass: rb.mass,
+            inertia: rb.inertia.unwrap_or_default(),
+            ..ExtraMass::default()
+        };
+        let field = if rb.inertia.is_some() { format!("{f}.inertia") } else { f.clone() };
         let master =
-            fe.rigid_body(&nodes, reference, extra).map_err(|e| field_error(case, &f, e))?;
-        // The reference node joins the mesh (output, probes) and the sets `all` and
-        // `<set>_reference`.
-        let p = fe.initial_positions()[master];
-        mesh.push_node([p.x, p.y, p.z]);
+            fe.rigid_body(&nodes, reference, extra).map_err(|e| field_error(case, &field, e))?;
+        if !matches!(reference, RigidReference::Node(_)) {
+            // A new reference node joins the mesh (output, probes) and the set `all`.
+            let p = fe.initial_positions()[master];
+            mesh.push_node([p.x, p.y, p.z]);
+            mesh.node_sets.get_mut("all").expect("built with the mesh").push(master);
+            body_of.push(None);
+        }
         mesh.node_sets.insert(format!("{}_reference", rb.set), vec![master]);
-        mesh.node_sets.get_mut("all").expect("built with the mesh").push(master);
-        body_of.push(None);
-        nodes.iter().for_each(|&n| body_of[n] = Some(k));
+        nodes.iter().filter(|&&n| n != master).for_each(|&n| body_of[n] = Some(k));
     }
     let statics = s.integrator() == Integrator::Static;
     let default_curve = if statics { Curve::Linear } else { Curve::Constant };
@@ -372,6 +392,17 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
                 for n in node_set(&mesh, set, &format!("{f}.set"), case)? {
                     fe.point_load(n, dof.index(), value, c.clone());
                 }
+            }
+            LoadKind::Pressure { set: Some(name), p } if solid_set(&mesh, name, &kept) => {
+                let faces = solid_faces(&mesh, name, &kept);
+                if faces.is_empty() {
+                    return Err(field_error(
+                        case,
+                        &format!("{f}.set"),
+                        format!("no boundary face of a tet of a part lies in \"{name}\""),
+                    ));
+                }
+                fe.face_pressure(&faces, p, c).map_err(|e| field_error(case, &f, e))?;
             }
             LoadKind::Pressure { set, p } => {
                 let face =
@@ -433,6 +464,41 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
     let length =
         if thinnest.is_finite() { thinnest } else { 1e-3 * validate::diagonal(&mesh.nodes) };
     Ok(Structure { mesh, model: fe, v0, cells, length })
+}
+
+/// Whether the load set `name` names faces of solids: a cell set of tets, a cell set of
+/// faces in no part (a gmsh physical surface on a solid), or a node set (not a cell set)
+/// when the model has tets.
+fn solid_set(mesh: &Mesh, name: &str, kept: &[usize]) -> bool {
+    let tets = || kept.iter().any(|&c| mesh.cells[c].kind == CellKind::Tet4);
+    match mesh.cell_set(name) {
+        Ok(cells) => {
+            cells.iter().all(|&c| mesh.cells[c].kind == CellKind::Tet4)
+                || (tets() && cells.iter().all(|c| kept.binary_search(c).is_err()))
+        }
+        Err(_) => mesh.node_set(name).is_ok() && tets(),
+    }
+}
+
+/// The boundary faces (outward, `wet::tet_boundary`) a pressure on the solid set `name`
+/// acts on: those of its tets, or the boundary faces of the model's tets whose nodes all
+/// belong to the set's cells or nodes.
+fn solid_faces(mesh: &Mesh, name: &str, kept: &[usize]) -> Vec<[usize; 3]> {
+    let is_tet = |c: &usize| mesh.cells[*c].kind == CellKind::Tet4;
+    if let Ok(cells) = mesh.cell_set(name) {
+        if cells.iter().all(is_tet) {
+            return tet_boundary(mesh, cells);
+        }
+    }
+    let mut inside = vec![false; mesh.nodes.len()];
+    match mesh.cell_set(name) {
+        Ok(cells) => {
+            cells.iter().flat_map(|&c| &mesh.cells[c].nodes).for_each(|&n| inside[n] = true)
+        }
+        Err(_) => mesh.node_set(name).unwrap_or(&[]).iter().for_each(|&n| inside[n] = true),
+    }
+    let tets: Vec<usize> = kept.iter().copied().filter(is_tet).collect();
+    tet_boundary(mesh, &tets).into_iter().filter(|f| f.iter().all(|&n| inside[n])).collect()
 }
 
 /// The `[structure]` section of a case, or an error naming the file.

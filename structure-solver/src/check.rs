@@ -40,7 +40,7 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
     writeln!(w, "{file}: structure ok")?;
     let probe_nodes: Vec<usize>;
     let mesh = if case.fluid.is_some() {
-        let Coupled { structure, wet, dt_stable } = prepare_coupled(case)?;
+        let Coupled { structure, wet, dt_stable, .. } = prepare_coupled(case)?;
         let scheme = case.coupling.scheme;
         let dt = case.coupling.dt.min(case.coupling.t_end);
         if let Some(message) = unstable_coupling(dt, dt_stable, scheme) {

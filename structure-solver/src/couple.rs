@@ -34,7 +34,7 @@ use crate::model::Model;
 use crate::output::FieldOutput;
 use crate::restart::{save_dynamics, save_state, PART};
 use crate::state_check::{check_dofs, check_state};
-use crate::time::{critical_dt, CentralDifference, Implicit, ImplicitScheme};
+use crate::time::{critical_dt, CentralDifference, Implicit, ImplicitScheme, StableStep};
 
 pub use crate::wet::{wet_surface, WetSurface};
 
@@ -68,6 +68,7 @@ pub struct Participant {
     first_dt: f64,
     t_end: f64,
     dt_stable: f64,
+    stable_rule: Option<StableStep>,
     t: f64,
     /// Coupling steps completed.
     steps: u64,
@@ -106,6 +107,9 @@ pub struct Coupled {
     pub structure: Structure,
     pub wet: WetSurface,
     pub dt_stable: f64,
+    /// Central differences: the stable step recomputed after every step from the element
+    /// bound at the current configuration (reported to the launcher).
+    pub stable_rule: Option<StableStep>,
 }
 
 /// Builds and checks the `[structure]` of a coupled `case`.
@@ -140,12 +144,13 @@ pub fn prepare_coupled(case: &Case) -> anyhow::Result<Coupled> {
     let wet_name = need(&s.wet_set, "wet_set", case)?;
     let wet = wet_surface(&structure.mesh, wet_name)
         .map_err(|e| field_error(case, "structure.wet_set", e))?;
-    let dt_stable = if explicit {
-        critical_dt(&mut structure.model, 0.0, 100, 1e-9 * structure.length).stable(1.0)
+    let (dt_stable, stable_rule) = if explicit {
+        let estimate = critical_dt(&mut structure.model, 0.0, 100, 1e-9 * structure.length);
+        (estimate.stable(1.0), Some(StableStep::new(&estimate, 1.0)))
     } else {
-        f64::INFINITY
+        (f64::INFINITY, None)
     };
-    Ok(Coupled { structure, wet, dt_stable })
+    Ok(Coupled { structure, wet, dt_stable, stable_rule })
 }
 
 /// The refusal of a first coupling step `dt` above the stable step of the scheme's central
@@ -163,7 +168,7 @@ impl Participant {
     pub fn new(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Participant> {
         let s = section(case)?;
         let scheme = case.coupling.scheme;
-        let Coupled { structure, wet, dt_stable } = prepare_coupled(case)?;
+        let Coupled { structure, wet, dt_stable, stable_rule } = prepare_coupled(case)?;
         let Structure { mesh, model, v0, cells, .. } = structure;
         let dir = OutputDir::create(out, Policy::Existing)
             .or_else(|_| OutputDir::create(out, Policy::Overwrite))?;
@@ -185,6 +190,7 @@ impl Participant {
             first_dt: case.coupling.dt.min(case.coupling.t_end),
             t_end: case.coupling.t_end,
             dt_stable,
+            stable_rule,
             t: 0.0,
             steps: 0,
             checkpoints: dir.path().join("checkpoints"),
@@ -417,6 +423,9 @@ impl Participant {
             }
         }
         self.check_state(n, t_to, dt)?;
+        if let Some(rule) = self.stable_rule {
+            self.dt_stable = rule.at(&self.model);
+        }
         self.t = t_to;
         self.steps = n + 1;
         let (fields, model) = (self.fields.as_mut(), &self.model);

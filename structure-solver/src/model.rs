@@ -34,6 +34,19 @@ pub trait Model: Send {
     /// External force vector at time `t` at the current configuration (follower pressure).
     fn external_force(&mut self, t: f64, f: &mut [f64]);
 
+    /// External force at `t` with `extra`, a nodal load from outside the model (6 per node,
+    /// the coupling's), both through the model's one constraint reduction (rigid slaves to
+    /// their master, skew-plane nodes to their plane). The default adds `extra` to
+    /// `external_force`, for models without such constraints.
+    fn external_force_with(&mut self, t: f64, extra: Option<&[f64]>, f: &mut [f64]) {
+        self.external_force(t, f);
+        if let Some(x) = extra {
+            for (f, x) in f.iter_mut().zip(x) {
+                *f += x;
+            }
+        }
+    }
+
     /// Consistent tangent (material + geometric) of internal minus external force, as triplets.
     fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>);
 

@@ -10,7 +10,7 @@ use interface_protocol::resources::step_count;
 use crate::assembly::RotaryInertia;
 use crate::build::{build, field_error, need, section, Structure};
 use crate::model::Model;
-use crate::time::critical_dt;
+use crate::time::{critical_dt, StableStep};
 
 /// A case ready to run alone.
 pub struct Alone {
@@ -23,6 +23,9 @@ pub struct Alone {
     /// The stable step of central differences (the smaller of the element bound and the power
     /// iteration of `time::critical`); `None` for the other integrators.
     pub stable: Option<f64>,
+    /// Central differences without `structure.dt`: the step recomputed every step from the
+    /// element bound at the current configuration (`safety` stated in the case, 0.8 else).
+    pub adaptive: Option<StableStep>,
     /// Steps to `t_end`.
     pub steps: u64,
     /// The node of each `[[structure.probes]]`.
@@ -67,11 +70,17 @@ pub fn prepare_alone(case: &Case) -> anyhow::Result<Alone> {
             ),
         ));
     }
+    let mut adaptive = None;
     let (dt, stable) = match integrator {
         Integrator::CentralDifference => {
             let probe = 1e-9 * structure.length;
-            let stable = critical_dt(&mut structure.model, 0.0, 100, probe).stable(1.0);
-            let dt = s.dt.unwrap_or(s.safety.unwrap_or(0.8) * stable);
+            let estimate = critical_dt(&mut structure.model, 0.0, 100, probe);
+            let stable = estimate.stable(1.0);
+            let safety = s.safety.unwrap_or(0.8);
+            if s.dt.is_none() {
+                adaptive = Some(StableStep::new(&estimate, safety));
+            }
+            let dt = s.dt.unwrap_or(safety * stable);
             if !(dt.is_finite() && dt > 0.0) {
                 bail!("{}: no stable step could be estimated; give `structure.dt`", file.display());
             }
@@ -97,5 +106,5 @@ pub fn prepare_alone(case: &Case) -> anyhow::Result<Alone> {
     };
     let mesh = &structure.mesh;
     let probe_nodes = s.probes.iter().map(|p| mesh.nearest_node(p.point)).collect();
-    Ok(Alone { structure, integrator, t_end, dt, stable, steps, probe_nodes })
+    Ok(Alone { structure, integrator, t_end, dt, stable, adaptive, steps, probe_nodes })
 }

@@ -73,7 +73,7 @@ pub fn wet_surface(mesh: &Mesh, name: &str) -> Result<WetSurface, String> {
 /// The boundary of the tets `cells`: the faces that belong to exactly one of them, as triangles
 /// ordered counter-clockwise seen from outside (normal `(x1 - x0) × (x2 - x0)` away from the
 /// tet's fourth node), in cell order.
-fn tet_boundary(mesh: &Mesh, cells: &[usize]) -> Vec<[usize; 3]> {
+pub fn tet_boundary(mesh: &Mesh, cells: &[usize]) -> Vec<[usize; 3]> {
     let mut faces = Vec::with_capacity(4 * cells.len());
     let mut count = std::collections::HashMap::new();
     for &c in cells {

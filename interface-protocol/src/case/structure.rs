@@ -89,7 +89,9 @@
 //! value = 10.0
 //! curve = { ramp = 1e-3 }
 //! # pressure = 1e5, set = "all"     # follower pressure on shell cells, along the normal of
-//! #                                 # the cells' node order
+//! #                                 # the cells' node order; on a set of tets, of faces in
+//! #                                 # no part or of nodes of a solid: on the solid's boundary
+//! #                                 # faces there, pushing into it
 //! # gravity = [0.0, 0.0, -9.81]     # acceleration on the lumped mass
 //!
 //! [[structure.initial_velocity]]
@@ -106,7 +108,10 @@
 //! # [[structure.rigid_bodies]]
 //! # set = "hub"
 //! # reference = [0.0, 0.0, 0.0]     # default: the mass centre of the set
+//! # reference_set = "hub_centre"    # or an existing node (a set of one node) as reference
 //! # mass = 1.0                      # mass added at the reference node
+//! # inertia = [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.2]]  # rotary inertia added
+//! #                                 # about the reference node (global axes, symmetric)
 //! ```
 
 use std::collections::BTreeMap;
@@ -146,7 +151,8 @@ pub struct StructureSection {
     /// Default `central_difference`.
     #[serde(default)]
     pub integrator: Option<Integrator>,
-    /// Time step; central differences default to `safety` x the critical step.
+    /// Time step; central differences default to `safety` x the critical step, recomputed
+    /// every step from the element bound at the current configuration.
     #[serde(default)]
     pub dt: Option<f64>,
     /// Fraction of the critical step; default 0.8.
@@ -581,7 +587,9 @@ pub struct StructureProbe {
 }
 
 /// `[[structure.rigid_bodies]]`: the nodes of `set` move as one rigid body with a new
-/// reference node at `reference` (default their mass centre), which carries `mass` more.
+/// reference node at `reference` (default their mass centre), or the existing node of the
+/// one-node set `reference_set`, which carries `mass` and the rotary inertia `inertia`
+/// (about it, global axes) more.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigidPart {
@@ -589,7 +597,11 @@ pub struct RigidPart {
     #[serde(default)]
     pub reference: Option<[f64; 3]>,
     #[serde(default)]
+    pub reference_set: Option<String>,
+    #[serde(default)]
     pub mass: f64,
+    #[serde(default)]
+    pub inertia: Option<[[f64; 3]; 3]>,
 }
 
 impl StructureSection {

@@ -1,4 +1,5 @@
-//! Structured mesh generators for plates, cylinders, spheres, annuli and beams. Each maps a
+//! Structured mesh generators for plates, cylinders, spheres, annuli, beams and tet blocks
+//! ([`block`]). Each surface generator maps a
 //! `nu x nv` grid of the unit square onto the surface; node `(i, j)` is `j (nu + 1) + i`.
 //! Node sets `u0`, `u1`, `v0`, `v1` are the four grid edges, cell set `all` every cell; cells
 //! are quads `(i, j), (i+1, j), (i+1, j+1), (i, j+1)` (use `Mesh::to_triangles` for triangles).
@@ -79,5 +80,64 @@ pub fn line(p0: [f64; 3], p1: [f64; 3], n: usize) -> Mesh {
     m.node_sets.insert("start".into(), vec![0]);
     m.node_sets.insert("end".into(), vec![n]);
     m.cell_sets.insert("all".into(), (0..n).collect());
+    m
+}
+
+/// The block `[0, lx] x [0, ly] x [0, lz]` of `nx x ny x nz` cubes, each split into the six
+/// tets of Kuhn's subdivision about its main diagonal (a conforming mesh, every tet
+/// positively oriented). Node `(i, j, k)` is `(k (ny + 1) + j) (nx + 1) + i`; node sets `x0`,
+/// `x1`, `y0`, `y1`, `z0`, `z1` are the six faces, cell set `all` every tet.
+pub fn block(l: [f64; 3], n: [usize; 3]) -> Mesh {
+    let [nx, ny, nz] = n;
+    let mut m = Mesh::default();
+    let id = |i: usize, j: usize, k: usize| (k * (ny + 1) + j) * (nx + 1) + i;
+    for k in 0..=nz {
+        for j in 0..=ny {
+            for i in 0..=nx {
+                let f = |a: usize, b: usize, len: f64| len * a as f64 / b as f64;
+                m.nodes.push([f(i, nx, l[0]), f(j, ny, l[1]), f(k, nz, l[2])]);
+            }
+        }
+    }
+    // the six monotone paths from corner 0 to corner 7 of a unit cube, one tet each
+    const PATHS: [[usize; 3]; 6] =
+        [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                for path in PATHS {
+                    let mut c = [i, j, k];
+                    let mut nodes = vec![id(c[0], c[1], c[2])];
+                    for axis in path {
+                        c[axis] += 1;
+                        nodes.push(id(c[0], c[1], c[2]));
+                    }
+                    let p = |q: usize| nalgebra::Vector3::from(m.nodes[nodes[q]]);
+                    if (p(1) - p(0)).cross(&(p(2) - p(0))).dot(&(p(3) - p(0))) < 0.0 {
+                        nodes.swap(1, 2);
+                    }
+                    m.cells.push(Cell { kind: CellKind::Tet4, nodes });
+                }
+            }
+        }
+    }
+    let face = |axis: usize, at: usize| -> Vec<usize> {
+        let mut out = Vec::new();
+        for k in 0..=nz {
+            for j in 0..=ny {
+                for i in 0..=nx {
+                    if [i, j, k][axis] == at {
+                        out.push(id(i, j, k));
+                    }
+                }
+            }
+        }
+        out
+    };
+    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+        m.node_sets.insert(format!("{name}0"), face(axis, 0));
+        m.node_sets.insert(format!("{name}1"), face(axis, n[axis]));
+    }
+    m.cell_sets.insert("all".into(), (0..m.cells.len()).collect());
     m
 }

@@ -1,7 +1,8 @@
 //! The critical step of central differences, `Δt_cr = 2/ω_max` (DESIGN §6: all stiffness
 //! included), estimated from the model: the elements' own estimate (`Model::stable_dt`), a
 //! matrix-free power iteration on `M⁻¹K` through the internal force, and Gershgorin's bound
-//! `ω_max² <= max_i Σ_j |K_ij| / sqrt(m_i m_j)` which never overestimates the step.
+//! `ω_max² <= max_i Σ_j |K_ij| / sqrt(m_i m_j)` which never overestimates the step; and the
+//! rule that recomputes the step every step from the element bound ([`StableStep`]).
 
 use faer::sparse::Triplet;
 
@@ -23,6 +24,41 @@ impl CriticalDt {
     /// The step to use: `safety ·` the smallest estimate of the element and power iterations.
     pub fn stable(&self, safety: f64) -> f64 {
         safety * self.element.min(self.power)
+    }
+}
+
+/// The step of central differences taken at every step of a run: `safety · ratio ·` the
+/// element bound at the current configuration (`Model::stable_dt`), `ratio = min(1,
+/// power / element)` of the estimates at the start, so the first step is
+/// `safety · CriticalDt::stable(1)` and later ones follow the element bound as elements
+/// deform; `fallback` when the model has no element bound.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StableStep {
+    pub safety: f64,
+    pub ratio: f64,
+    pub fallback: f64,
+}
+
+impl StableStep {
+    /// The rule of a run started with the estimates `initial` and the stated `safety`.
+    pub fn new(initial: &CriticalDt, safety: f64) -> Self {
+        let stable = initial.stable(1.0);
+        let ratio = if initial.element.is_finite() && initial.element > 0.0 {
+            (stable / initial.element).min(1.0)
+        } else {
+            1.0
+        };
+        StableStep { safety, ratio, fallback: safety * stable }
+    }
+
+    /// The step at the model's current configuration.
+    pub fn at(&self, model: &dyn Model) -> f64 {
+        let element = model.stable_dt();
+        if element.is_finite() {
+            self.safety * self.ratio * element
+        } else {
+            self.fallback
+        }
     }
 }
 

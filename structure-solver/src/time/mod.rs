@@ -7,13 +7,13 @@
 //! state plus [`Dynamics`].
 //!
 //! Loads received over the coupling interface enter every step as an extra nodal force vector
-//! (`extra`), added to the model's own external forces.
+//! (`extra`) that the model reduces with its own external forces (`Model::external_force_with`).
 
 pub mod critical;
 pub mod explicit;
 pub mod implicit;
 
-pub use critical::{critical_dt, CriticalDt};
+pub use critical::{critical_dt, CriticalDt, StableStep};
 pub use explicit::CentralDifference;
 pub use implicit::{Implicit, ImplicitError, ImplicitScheme, NewtonParams, StepInfo};
 
@@ -50,12 +50,7 @@ fn out_of_balance(
     fi.fill(0.0);
     model.internal_force(fi);
     r.fill(0.0);
-    model.external_force(t, r);
-    if let Some(x) = extra {
-        for (r, x) in r.iter_mut().zip(x) {
-            *r += x;
-        }
-    }
+    model.external_force_with(t, extra, r);
     for (r, f) in r.iter_mut().zip(fi.iter()) {
         *r -= f;
     }

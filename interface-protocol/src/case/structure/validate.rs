@@ -248,6 +248,30 @@ impl StructureSection {
                     format!("expected a finite mass >= 0, got {}", r.mass),
                 ));
             }
+            if r.reference.is_some() && r.reference_set.is_some() {
+                return Err((
+                    format!("{f}.reference_set"),
+                    "give `reference` (a new node at a point) or `reference_set` (an existing \
+                     node), not both"
+                        .into(),
+                ));
+            }
+            if let Some(j) = &r.inertia {
+                for (i, row) in j.iter().enumerate() {
+                    finite(&format!("{f}.inertia[{i}]"), row)?;
+                }
+                let mut asym = (0..3).flat_map(|i| (0..3).map(move |k| (i, k)));
+                if let Some((i, k)) = asym.find(|&(i, k)| j[i][k] != j[k][i]) {
+                    return Err((
+                        format!("{f}.inertia"),
+                        format!(
+                            "expected a symmetric tensor, got inertia[{i}][{k}] = {} and \
+                             inertia[{k}][{i}] = {}",
+                            j[i][k], j[k][i]
+                        ),
+                    ));
+                }
+            }
         }
         Ok(())
     }

@@ -1,0 +1,215 @@
+//! A model from mesh cells: each cell becomes the element its `Part` says (BT4 shells gathered
+//! into one blocked part), the dofs without stiffness are constrained, and the lumped mass and
+//! element bound of the critical step follow the chosen rotary inertia.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::stable_step::{characteristic_length, ElementBound};
+use super::{gather, AssemblyError, Bt4Part, FeModel, Part, State};
+use crate::elements::bt4::{Bt4, Bt4Settings};
+use crate::elements::{Element, ElementKind, RotaryInertia};
+use crate::material::{Elastic, ThicknessRule, J2};
+use crate::mesh::{CellKind, Mesh};
+
+impl FeModel {
+    /// Builds the model of `mesh`, every cell becoming the element `part(cell index)` says.
+    pub fn new(mesh: &Mesh, part: impl Fn(usize) -> Part) -> Result<Self, AssemblyError> {
+        let nn = mesh.nodes.len();
+        let x0: Vec<Vector3<f64>> = mesh.nodes.iter().map(|p| Vector3::from(*p)).collect();
+        let mut elements = Vec::with_capacity(mesh.cells.len());
+        let mut element_cell = Vec::with_capacity(mesh.cells.len());
+        let mut bt4_conn = Vec::new();
+        let mut bt4_h = Vec::new();
+        let mut bt4_material: Option<(J2, usize)> = None;
+        for (ci, cell) in mesh.cells.iter().enumerate() {
+            if let Some(&bad) = cell.nodes.iter().find(|&&n| n >= nn) {
+                return Err(AssemblyError::NodeRange { node: bad, n: nn });
+            }
+            if let (CellKind::Quad4, Part::Bt4(s, y)) = (cell.kind, part(ci)) {
+                let j2 = J2 {
+                    elastic: Elastic { e: s.e, nu: s.nu, rho: s.rho },
+                    sigma_y: y.map_or(f64::INFINITY, |y| y.sigma_y),
+                    h: y.map_or(0.0, |y| y.hardening),
+                };
+                let mat = (j2, y.map_or(5, |y| y.points));
+                if *bt4_material.get_or_insert(mat) != mat {
+                    return Err(AssemblyError::Bt4Material { cell: ci });
+                }
+                let nd = &cell.nodes;
+                bt4_conn.push([nd[0], nd[1], nd[2], nd[3]].map(|n| n as u32));
+                bt4_h.push(s.h);
+                continue;
+            }
+            let p = gather(&x0, &cell.nodes);
+            let nd = &cell.nodes;
+            let (shell, yield_) = match part(ci) {
+                Part::Shell(s) => (Some(s), None),
+                Part::ShellJ2(s, y) => (Some(s), Some(y)),
+                _ => (None, None),
+            };
+            let el = match (cell.kind, part(ci)) {
+                (CellKind::Quad4, Part::Shell(_) | Part::ShellJ2(..)) => {
+                    let s = shell.expect("a shell part");
+                    let x = [p[0], p[1], p[2], p[3]];
+                    Element::quad4([nd[0], nd[1], nd[2], nd[3]], &x, &s, yield_)
+                }
+                (CellKind::Tri3, Part::Shell(_) | Part::ShellJ2(..)) => {
+                    let s = shell.expect("a shell part");
+                    Element::tri3([nd[0], nd[1], nd[2]], &[p[0], p[1], p[2]], &s, yield_)
+                }
+                (CellKind::Line2, Part::Beam(s, up)) => {
+                    Element::beam2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s)
+                }
+                (CellKind::Tet4, Part::Solid(mat)) => {
+                    Element::tet4([nd[0], nd[1], nd[2], nd[3]], &[p[0], p[1], p[2], p[3]], mat)
+                }
+                (kind, p) => {
+                    let part = match p {
+                        Part::Shell(_) | Part::ShellJ2(..) => "a shell section",
+                        Part::Bt4(..) => "a BT4 shell (quadrilaterals only)",
+                        Part::Beam(..) => "a beam section",
+                        Part::Solid(_) => "a solid material",
+                    };
+                    return Err(AssemblyError::Mismatch { cell: ci, kind, part });
+                }
+            };
+            elements.push(el);
+            element_cell.push(ci);
+        }
+        // dofs without stiffness: unused nodes, rotations of solid-only nodes
+        let mut constrained = vec![true; 6 * nn];
+        for e in &elements {
+            for &n in &e.nodes {
+                let k = if e.has_rotations() { 6 } else { 3 };
+                constrained[6 * n..6 * n + k].fill(false);
+            }
+        }
+        for c in &bt4_conn {
+            for &n in c {
+                constrained[6 * n as usize..6 * n as usize + 6].fill(false);
+            }
+        }
+        let bt4 = bt4_material.map(|(material, points)| {
+            let settings = Bt4Settings {
+                rule: ThicknessRule::gauss(points),
+                rotary: RotaryInertia::Physical,
+                ..Bt4Settings::default()
+            };
+            Bt4Part {
+                shells: Bt4::new(bt4_conn, bt4_h, material, settings),
+                x: x0.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                du: vec![0.0; 6 * nn],
+                evaluated: false,
+            }
+        });
+        let mut state_offsets = vec![0];
+        for e in &elements {
+            state_offsets.push(state_offsets[state_offsets.len() - 1] + e.n_state());
+        }
+        let state = State {
+            x: x0.clone(),
+            r: vec![Matrix3::identity(); nn],
+            spin_sum: vec![Vector3::zeros(); nn],
+            material: vec![0.0; state_offsets[elements.len()]],
+        };
+        let mut m = FeModel {
+            x0,
+            trial: state.clone(),
+            committed: state,
+            elements,
+            state_offsets,
+            cells: mesh.cells.iter().map(|c| c.nodes.clone()).collect(),
+            element_cell,
+            bt4,
+            rotary: RotaryInertia::Physical,
+            mass: vec![],
+            node_mass: vec![],
+            constrained,
+            user_fixed: vec![false; 6 * nn],
+            rigid: vec![],
+            skew: vec![],
+            skew_of: vec![None; nn],
+            body_of: vec![None; nn],
+            slave: vec![false; nn],
+            fint_full: vec![],
+            fint_valid: false,
+            prescribed: vec![],
+            point_loads: vec![],
+            pressures: vec![],
+            face_pressures: vec![],
+            gravity: None,
+            external: vec![0.0; 6 * nn],
+            held_extra: vec![],
+            scratch: vec![],
+            element_bound: vec![],
+        };
+        m.set_rotary_inertia(RotaryInertia::Physical);
+        Ok(m)
+    }
+
+    /// carry the element's translational mass).
+    pub(super) fn element_mass(&self, e: &Element) -> Vec<f64> {
+        let mut m = e.mass.clone();
+        if matches!(e.kind, ElementKind::Quad4 | ElementKind::Tri3) {
+            // The element mass holds the physical `m h²/12`.
+            for i in 0..e.nodes.len() {
+                let extra = m[6 * i] * self.rotary.added_area(e.measure) / 12.0;
+                for c in 3..6 {
+                    m[6 * i + c] += extra;
+                }
+            }
+        }
+        m
+    }
+
+    /// Chooses the rotary inertia and recomputes the lumped mass and critical step.
+    pub fn set_rotary_inertia(&mut self, rotary: RotaryInertia) {
+        self.rotary = rotary;
+        let mut mass = vec![0.0; self.x0.len() * 6];
+        let mut bound = Vec::with_capacity(self.elements.len());
+        for e in &self.elements {
+            let me = self.element_mass(e);
+            for (i, &n) in e.nodes.iter().enumerate() {
+                for c in 0..6 {
+                    mass[6 * n + c] += me[6 * i + c];
+                }
+            }
+            let x = gather(&self.x0, &e.nodes);
+            let w2 = e.max_frequency_squared(&x, &me);
+            let dt = if w2 > 0.0 { 2.0 / w2.sqrt() } else { f64::INFINITY };
+            bound.push(ElementBound { dt, length: characteristic_length(e.kind, &x) });
+        }
+        self.element_bound = bound;
+        if let Some(b) = &mut self.bt4 {
+            b.shells.settings.rotary = rotary;
+            let x0: Vec<[f64; 3]> = self.x0.iter().map(|p| [p.x, p.y, p.z]).collect();
+            b.shells.lumped_mass(&x0, &mut mass);
+        }
+        self.node_mass = mass;
+        self.reduce_mass();
+    }
+
+    /// The lumped mass of the free dofs: rigid slaves carry nothing, masters the diagonal of
+    /// their body's mass block in the current orientation (the full block acts through the
+    /// `Model` mass hooks).
+    pub(super) fn reduce_mass(&mut self) {
+        self.mass.clone_from(&self.node_mass);
+        for b in &mut self.rigid {
+            b.set_mass(&self.node_mass);
+            let m6 = b.mass6(&self.trial.r[b.master]);
+            for c in 0..6 {
+                self.mass[6 * b.master + c] = m6[(c, c)];
+            }
+            for &s in &b.slaves {
+                self.mass[6 * s..6 * s + 6].fill(0.0);
+            }
+        }
+        for k in &self.skew {
+            let d = 6 * k.node;
+            let m = k.mass(&self.node_mass[d..d + 6]);
+            for c in 0..6 {
+                self.mass[d + c] = m[(c, c)];
+            }
+        }
+    }
+}

@@ -1,0 +1,208 @@
+//! `FeModel`: an assembled finite-element structure implementing `Model` (DESIGN §6).
+//!
+//! Files by job: `build` (mesh cells to elements, lumped mass), `constraints` (fixed,
+//! prescribed and skew-symmetry dofs and their reduction), `rigid_bodies` (rigid bodies and
+//! links: slaves on masters, the reduction `Tᵀ f`, `Tᵀ K T`), `loads` (time curves, point
+//! loads, pressure, gravity, the coupling's nodal array), `forces` (the `Model` the
+//! integrators call; `element_forces` its element loop), `stable_step` (the element bound of the critical step at the current
+//! configuration), `state` (the committed state checkpoints hold).
+//!
+//! Six dofs per node `[ux, uy, uz, θx, θy, θz]`; rotations are stored as matrices and updated
+//! by spatial spins, `R ← exp([δθ]×) R`. Constraints: fixed dofs, symmetry planes normal to a
+//! global axis (`u·n = 0`, rotation only about `n`) or to any vector (`symmetry_plane`: a
+//! linear constraint per node, reduced like the rigid bodies), prescribed translations and
+//! rotations over time (a prescribed rotation dof accumulates its spins). Loads: point loads,
+//! gravity, follower pressure on shells and an external nodal array filled by the coupling.
+//! Each load scales with a `Curve` of time; static solves use `t` as the load factor.
+//!
+//! Rigid bodies and links (`rigid`): slave nodes follow a master node; the model then returns
+//! reduced forces `Tᵀ f` and tangent `Tᵀ K T` (plus the geometric term of the rotating
+//! offsets), marks the slave dofs constrained, and moves slaves with their master in
+//! `apply_increment`, so the static and implicit solvers need nothing more; the explicit
+//! integrator uses the `Model` hooks for the master's mass block and free rigid-body drift.
+//! A master at a point or at the mass centre is a node appended after the mesh nodes.
+//!
+//! Parts: elastic shells, J2 shells integrated through the thickness (MITC4, DKT), beams,
+//! tets, and the explicit-only one-point BT4 shells, which have no tangent (static and
+//! implicit solvers return an error for a model holding them).
+
+mod build;
+mod constraints;
+mod element_forces;
+mod forces;
+mod loads;
+mod rigid_bodies;
+mod stable_step;
+mod state;
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::elements::bt4::Bt4;
+pub use crate::elements::RotaryInertia;
+use crate::elements::{BeamSection, Element, ShellSection, ShellYield};
+use crate::material::Material;
+use crate::mesh::CellKind;
+use crate::rigid::RigidBody;
+
+use constraints::SkewNode;
+pub use loads::Curve;
+
+/// What a mesh cell becomes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Part {
+    Shell(ShellSection),
+    /// A shell of a J2 material integrated through the thickness (MITC4 or DKT).
+    ShellJ2(ShellSection, ShellYield),
+    /// A one-point Belytschko-Tsay shell (`elements::bt4`), elastic or J2 at the thickness
+    /// points of the yield (5 Gauss points when elastic): explicit only, it has no tangent,
+    /// so static and implicit solves refuse a model holding one. One material per model.
+    Bt4(ShellSection, Option<ShellYield>),
+    /// A beam whose local `y` axis is `up` projected normal to it.
+    Beam(BeamSection, [f64; 3]),
+    /// A solid of an elastic or J2 material.
+    Solid(Material),
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum AssemblyError {
+    #[error("cell {cell}: a {kind:?} cannot carry {part}")]
+    Mismatch { cell: usize, kind: CellKind, part: &'static str },
+    #[error("node {node} out of range ({n} nodes)")]
+    NodeRange { node: usize, n: usize },
+    #[error("cell {cell}: BT4 shells of one model share one material and thickness rule")]
+    Bt4Material { cell: usize },
+    #[error("symmetry plane: the normal {normal:?} is not a finite non-zero vector")]
+    BadNormal { normal: [f64; 3] },
+    #[error("symmetry plane: node {node} belongs to a rigid body")]
+    SymmetryRigid { node: usize },
+    #[error("symmetry plane: node {node} has a prescribed dof")]
+    SymmetryPrescribed { node: usize },
+}
+
+#[derive(Debug, Clone)]
+struct State {
+    x: Vec<Vector3<f64>>,
+    r: Vec<Matrix3<f64>>,
+    /// Accumulated spins (only read for prescribed rotation dofs).
+    spin_sum: Vec<Vector3<f64>>,
+    /// Material state of all elements, flat; element `e` owns
+    /// `state_offsets[e]..state_offsets[e + 1]` (tets: one point; J2 shells: every thickness
+    /// point; elastic elements: nothing).
+    material: Vec<f64>,
+}
+
+/// An assembled finite-element model.
+#[derive(Debug, Clone)]
+pub struct FeModel {
+    x0: Vec<Vector3<f64>>,
+    trial: State,
+    committed: State,
+    elements: Vec<Element>,
+    state_offsets: Vec<usize>,
+    /// Node lists of all mesh cells (pressure loads act on cells).
+    cells: Vec<Vec<usize>>,
+    /// Mesh cell of each element.
+    element_cell: Vec<usize>,
+    /// The explicit-only BT4 shells, if any.
+    bt4: Option<Bt4Part>,
+    rotary: RotaryInertia,
+    /// Lumped mass of the model's free dofs (rigid bodies reduced to their masters).
+    mass: Vec<f64>,
+    /// Lumped mass of every node as the elements give it (before the rigid reduction).
+    node_mass: Vec<f64>,
+    constrained: Vec<bool>,
+    /// Dofs fixed or prescribed by the user (the others of `constrained` have no stiffness
+    /// or are rigid slaves).
+    user_fixed: Vec<bool>,
+    rigid: Vec<RigidBody>,
+    /// Nodes on skew symmetry planes, and the entry of each node in it.
+    skew: Vec<SkewNode>,
+    skew_of: Vec<Option<usize>>,
+    /// Rigid body of each node (master or slave), and whether it is a slave.
+    body_of: Vec<Option<usize>>,
+    slave: Vec<bool>,
+    /// Internal force before the rigid reduction at the current configuration, if
+    /// `fint_valid` (the tangent's geometric term of rigid offsets reads it).
+    fint_full: Vec<f64>,
+    fint_valid: bool,
+    prescribed: Vec<(usize, f64, Curve)>,
+    point_loads: Vec<(usize, f64, Curve)>,
+    pressures: Vec<(Vec<usize>, f64, Curve)>,
+    /// Pressures on boundary faces of solids (outward counter-clockwise triangles).
+    face_pressures: Vec<(Vec<[usize; 3]>, f64, Curve)>,
+    gravity: Option<([f64; 3], Curve)>,
+    external: Vec<f64>,
+    /// The nodal load from outside the model given with the last external force
+    /// (`Model::external_force_with`; empty: none), reduced with the model's own loads.
+    held_extra: Vec<f64>,
+    /// Work arrays of the element force loop.
+    scratch: Vec<element_forces::ElementScratch>,
+    /// Each element's bound of the critical step at the reference configuration.
+    element_bound: Vec<stable_step::ElementBound>,
+}
+
+/// The BT4 shells of a model with their work arrays.
+#[derive(Debug, Clone)]
+struct Bt4Part {
+    shells: Bt4,
+    /// Positions and the increment since the last commit, in the layout `Bt4` reads.
+    x: Vec<[f64; 3]>,
+    du: Vec<f64>,
+    /// A trial state was computed since the last commit or revert.
+    evaluated: bool,
+}
+
+fn gather<T: Copy>(all: &[T], nodes: &[usize]) -> Vec<T> {
+    nodes.iter().map(|&n| all[n]).collect()
+}
+
+impl FeModel {
+    /// The elements, in mesh cell order.
+    pub fn elements(&self) -> &[Element] {
+        &self.elements
+    }
+
+    /// Committed material state of element `e` (`Element::n_state` values: J2 shells
+    /// `[εp_xx, εp_yy, γp_xy, α]` per thickness point, in-plane point major; tets
+    /// `[εp (6), α]`).
+    pub fn element_state(&self, e: usize) -> &[f64] {
+        &self.committed.material[self.state_offsets[e]..self.state_offsets[e + 1]]
+    }
+
+    /// The rigid bodies, in the order they were made.
+    pub fn rigid_bodies(&self) -> &[RigidBody] {
+        &self.rigid
+    }
+
+    /// Current nodal positions.
+    pub fn positions(&self) -> &[Vector3<f64>] {
+        &self.trial.x
+    }
+
+    /// Current nodal rotations.
+    pub fn rotations(&self) -> &[Matrix3<f64>] {
+        &self.trial.r
+    }
+
+    /// Initial nodal positions.
+    pub fn initial_positions(&self) -> &[Vector3<f64>] {
+        &self.x0
+    }
+
+    /// Sets the trial configuration directly (tests, restarts).
+    pub fn set_configuration(&mut self, x: &[Vector3<f64>], r: &[Matrix3<f64>]) {
+        self.trial.x.copy_from_slice(x);
+        self.trial.r.copy_from_slice(r);
+        self.fint_valid = false;
+    }
+
+    /// Accumulated spins of the committed configuration (checkpoints).
+    pub fn committed_spins(&self) -> &[Vector3<f64>] {
+        &self.committed.spin_sum
+    }
+
+    /// The explicit BT4 shells, if any (their state and output fields).
+    pub fn bt4(&self) -> Option<&Bt4> {
+        self.bt4.as_ref().map(|b| &b.shells)
+    }
+}
