@@ -51,8 +51,11 @@ pub struct CReference {
     /// Why it did not run (no C compiler at build time, or it failed).
     pub unavailable: Option<String>,
     pub element_updates_per_s: Option<f64>,
+    pub element_updates_per_cpu_s: Option<f64>,
     /// Rust on one thread (natural order) over C: above 1 when Rust is faster.
     pub rust_over_c: Option<f64>,
+    /// The same per second of processor time.
+    pub rust_over_c_cpu: Option<f64>,
     /// Largest difference of the end positions of the C and the Rust run, relative to the
     /// largest coordinate (round-off: the same operations in the same order).
     pub position_difference: Option<f64>,
@@ -69,6 +72,9 @@ pub struct ExplicitRun {
     pub element_updates_per_s: f64,
     pub element_updates_per_s_per_core: f64,
     pub ns_per_element_update: f64,
+    /// Per second of processor time of the process (all threads): the rate the code reaches
+    /// on the cores it got, when other work shares the machine (wall-clock rates then fall).
+    pub element_updates_per_cpu_s: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -277,19 +283,21 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
         for &t in threads {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
             let mut sim = Bt4Explicit::new(&plate);
-            let (rate, plastic) = pool.install(|| {
+            let (rate, cpu_rate, plastic) = pool.install(|| {
                 for _ in 0..WARMUP {
                     sim.step();
                 }
                 let alpha0 = sim.plastic();
-                let t0 = Instant::now();
+                let (t0, c0) = (Instant::now(), process_cpu_seconds());
                 for _ in 0..steps {
                     sim.step();
                 }
                 let secs = t0.elapsed().as_secs_f64();
+                let cpu = process_cpu_seconds() - c0;
                 let alpha = sim.plastic();
                 let yielding = alpha.iter().zip(&alpha0).filter(|(a, b)| a > b).count();
-                ((sim.bt4.n_elements() * steps) as f64 / secs, yielding as f64 / alpha.len() as f64)
+                let updates = (sim.bt4.n_elements() * steps) as f64;
+                (updates / secs, updates / cpu, yielding as f64 / alpha.len() as f64)
             });
             if !shuffled && rust_end.is_none() {
                 rust_end = Some(sim.x.clone());
@@ -308,14 +316,16 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
                 element_updates_per_s: rate,
                 element_updates_per_s_per_core: rate / t as f64,
                 ns_per_element_update: 1e9 / rate,
+                element_updates_per_cpu_s: cpu_rate,
             });
         }
     }
     let (ne, np, newton, bytes) = info.expect("one run at least");
     let natural = Bt4Plate::new(elements, false);
     let c_reference = match c_reference(&natural, WARMUP, steps) {
-        Ok((secs, x_c)) => {
+        Ok((secs, cpu, x_c)) => {
             let rate = (ne * steps) as f64 / secs;
+            let cpu_rate = (ne * steps) as f64 / cpu;
             let x_r = rust_end.expect("a natural run");
             let scale = x_r.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
             let diff = x_r
@@ -326,14 +336,18 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
             CReference {
                 unavailable: None,
                 element_updates_per_s: Some(rate),
+                element_updates_per_cpu_s: Some(cpu_rate),
                 rust_over_c: Some(runs[0].element_updates_per_s_per_core / rate),
+                rust_over_c_cpu: Some(runs[0].element_updates_per_cpu_s / cpu_rate),
                 position_difference: Some(diff / scale),
             }
         }
         Err(e) => CReference {
             unavailable: Some(format!("{e:#}")),
             element_updates_per_s: None,
+            element_updates_per_cpu_s: None,
             rust_over_c: None,
+            rust_over_c_cpu: None,
             position_difference: None,
         },
     };
@@ -371,7 +385,7 @@ fn c_reference(
     plate: &Bt4Plate,
     warmup: usize,
     steps: usize,
-) -> anyhow::Result<(f64, Vec<[f64; 3]>)> {
+) -> anyhow::Result<(f64, f64, Vec<[f64; 3]>)> {
     use crate::elements::section::SHEAR_FACTOR;
     use crate::elements::RotaryInertia;
     use anyhow::Context;
@@ -432,6 +446,7 @@ fn c_reference(
     anyhow::ensure!(run.status.success(), "{exe}: {}", String::from_utf8_lossy(&run.stderr));
     let report: serde_json::Value = serde_json::from_slice(&run.stdout)?;
     let secs = report["seconds"].as_f64().context("the C reference printed no seconds")?;
+    let cpu = report["cpu_seconds"].as_f64().context("the C reference printed no cpu_seconds")?;
     let bytes = std::fs::read(&output).with_context(|| format!("reading {}", output.display()))?;
     let _ = std::fs::remove_file(&output);
     anyhow::ensure!(
@@ -445,7 +460,21 @@ fn c_reference(
             std::array::from_fn(|k| f64::from_le_bytes(p[8 * k..8 * k + 8].try_into().unwrap()))
         })
         .collect();
-    Ok((secs, x))
+    Ok((secs, cpu, x))
+}
+
+/// Processor time of this process (user + system, all threads) from `/proc/self/stat`, in
+/// seconds (ticks of 1/100 s); 0 where there is no `/proc`.
+fn process_cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name (which may hold spaces) start at the state, field 3.
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    // utime and stime are fields 14 and 15: 11 and 12 after the state.
+    (ticks(11) + ticks(12)) / 100.0
 }
 
 /// Times Newmark steps of a clamped `n x n` MITC4 plate under a suddenly applied pressure.

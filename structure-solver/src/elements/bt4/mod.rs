@@ -11,8 +11,8 @@
 //!   out-of-plane and rotational modes, `γ_I = ¼ (h_I - (h·x̂) b_xI - (h·ŷ) b_yI)`,
 //!   `h = [1, -1, 1, -1]`;
 //! - hypoelastic plane-stress update in the corotated frame at `n` thickness points with the
-//!   J2 plane-stress return (at most `newton` updates; transverse shear stays elastic,
-//!   `τ = κ G γ`, κ = 5/6).
+//!   J2 plane-stress return (`newton` Newton updates, then the safeguarded fallback for points
+//!   still outside `return_tol`; transverse shear stays elastic, `τ = κ G γ`, κ = 5/6).
 //!
 //! A step takes the end positions `x^{n+1}` and the increment `Δu` (translations and global
 //! rotation increments) of the step: strain increments are computed in the mid-step geometry
