@@ -1,5 +1,6 @@
-//! `structure-solver bench`: the speed of the explicit BT4 kernel (element updates per second
-//! on one core, J2 with the plane-stress return at 5 thickness points) and of an implicit
+//! `structure-solver bench`: the speed of whole explicit BT4 steps (element updates per second
+//! per core, J2 with the plane-stress return at 5 thickness points; natural and shuffled
+//! element order, 1 and 2 threads) and of an implicit
 //! Newmark step of a 10k-node MITC4 shell with the time of each piece of a Newton iteration
 //! (internal force, tangent, factorisation, solve), printed as JSON (DESIGN §6, §7).
 
@@ -8,7 +9,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::assembly::{Curve, FeModel, Part};
-use crate::elements::bt4::{Bt4, Bt4Settings, LANES};
+use crate::elements::bt4::{Bt4, Bt4Settings, SimdPath, LANES};
 use crate::elements::ShellSection;
 use crate::material::{Elastic, J2};
 use crate::mesh::generate::rectangle;
@@ -28,10 +29,52 @@ pub struct ExplicitBench {
     pub thickness_points: usize,
     pub newton_updates: usize,
     pub lanes: usize,
+    /// The instruction set the block loop ran on.
+    pub simd_path: &'static str,
+    /// State and work arrays per element (double-buffered state, mesh, element forces,
+    /// incidence), without the nodal arrays.
+    pub bytes_per_element: f64,
+    /// Natural order on the first thread count (1 by default): the headline numbers.
+    pub element_updates_per_s_per_core: f64,
+    pub plastic_fraction: f64,
+    pub runs: Vec<ExplicitRun>,
+    /// Element updates per second on 2 threads over 1 thread, natural order.
+    pub speedup_2_threads_natural: Option<f64>,
+    pub speedup_2_threads_shuffled: Option<f64>,
+    /// The C reference of the same step (natural order, one thread), measured in this run.
+    pub c_reference: CReference,
+}
+
+/// The C reference `bench/bt4.c` (gcc -O3 -march=native -ffp-contract=off, blocked by 8).
+#[derive(Debug, Serialize)]
+pub struct CReference {
+    /// Why it did not run (no C compiler at build time, or it failed).
+    pub unavailable: Option<String>,
+    pub element_updates_per_s: Option<f64>,
+    pub element_updates_per_cpu_s: Option<f64>,
+    /// Rust on one thread (natural order) over C: above 1 when Rust is faster.
+    pub rust_over_c: Option<f64>,
+    /// The same per second of processor time.
+    pub rust_over_c_cpu: Option<f64>,
+    /// Largest difference of the end positions of the C and the Rust run, relative to the
+    /// largest coordinate (round-off: the same operations in the same order).
+    pub position_difference: Option<f64>,
+}
+
+/// One whole explicit step (forces, velocity and position update, stable step), timed.
+#[derive(Debug, Serialize)]
+pub struct ExplicitRun {
+    /// `natural` (row by row) or `shuffled` element order.
+    pub order: &'static str,
+    pub threads: usize,
     /// Share of thickness points yielding in the timed steps.
     pub plastic_fraction: f64,
+    pub element_updates_per_s: f64,
     pub element_updates_per_s_per_core: f64,
     pub ns_per_element_update: f64,
+    /// Per second of processor time of the process (all threads): the rate the code reaches
+    /// on the cores it got, when other work shares the machine (wall-clock rates then fall).
+    pub element_updates_per_cpu_s: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -115,67 +158,323 @@ fn steel() -> J2 {
     J2 { elastic: Elastic { e: 200e9, nu: 0.3, rho: 7800.0 }, sigma_y: 250e6, h: 1e9 }
 }
 
-/// Times the BT4 kernel alone on a `n x n` plate stretched and bent past yield at every step.
-pub fn explicit(n: usize, steps: usize) -> ExplicitBench {
-    let mesh = rectangle(1.0, 1.0, n, n);
-    let conn: Vec<[u32; 4]> = mesh
-        .cells
-        .iter()
-        .map(|c| [c.nodes[0], c.nodes[1], c.nodes[2], c.nodes[3]].map(|v| v as u32))
-        .collect();
-    let ne = conn.len();
-    let settings = Bt4Settings::default();
-    let (np, newton) = (settings.rule.len(), settings.newton);
-    let mut bt4 = Bt4::new(conn, vec![0.01; ne], steel(), settings);
-    let mut x: Vec<[f64; 3]> = mesh.nodes.clone();
-    let mut du = vec![0.0; 6 * x.len()];
-    let mut f = vec![0.0; 6 * x.len()];
-    // Biaxial stretch 2e-4 per step and a curvature increment: every point yields after a few
-    // steps and keeps yielding.
-    let mut step = |bt4: &mut Bt4, x: &mut Vec<[f64; 3]>| {
-        for (i, p) in x.iter_mut().enumerate() {
-            let (dx, dy) = (2e-4 * p[0], -0.5e-4 * p[1]);
-            p[0] += dx;
-            p[1] += dy;
-            du[6 * i] = dx;
-            du[6 * i + 1] = dy;
-            du[6 * i + 4] = 0.05 * p[0] * 1e-3;
-        }
-        f.fill(0.0);
-        bt4.internal_force(x, &du, &mut f);
-        bt4.commit();
-    };
-    for _ in 0..20 {
-        step(&mut bt4, &mut x);
-    }
-    let alpha0: Vec<f64> = (0..ne)
-        .flat_map(|e| (0..np).map(move |p| (e, p)))
-        .map(|(e, p)| bt4.plastic_strain(e, p))
-        .collect();
-    let t0 = Instant::now();
-    for _ in 0..steps {
-        step(&mut bt4, &mut x);
-    }
-    let secs = t0.elapsed().as_secs_f64();
-    let mut plastic = 0usize;
-    for e in 0..ne {
-        for p in 0..np {
-            if bt4.plastic_strain(e, p) > alpha0[e * np + p] {
-                plastic += 1;
+/// The bench plate: `n x n` quads on the unit square, its connectivity in natural or
+/// shuffled order.
+pub struct Bt4Plate {
+    pub x0: Vec<[f64; 3]>,
+    pub conn: Vec<[u32; 4]>,
+}
+
+impl Bt4Plate {
+    pub fn new(elements: usize, shuffled: bool) -> Bt4Plate {
+        let n = (elements as f64).sqrt().ceil().max(1.0) as usize;
+        let mesh = rectangle(1.0, 1.0, n, n);
+        let mut conn: Vec<[u32; 4]> = mesh
+            .cells
+            .iter()
+            .map(|c| [c.nodes[0], c.nodes[1], c.nodes[2], c.nodes[3]].map(|v| v as u32))
+            .collect();
+        if shuffled {
+            // Fisher-Yates with a fixed xorshift sequence.
+            let mut r = 0x9e37_79b9_7f4a_7c15u64;
+            for i in (1..conn.len()).rev() {
+                r ^= r << 13;
+                r ^= r >> 7;
+                r ^= r << 17;
+                conn.swap(i, (r % (i as u64 + 1)) as usize);
             }
         }
+        Bt4Plate { x0: mesh.nodes, conn }
     }
-    let updates = (ne * steps) as f64;
-    ExplicitBench {
+
+    /// Initial velocity (6 per node): a biaxial stretch at 160/s and a transverse sine at
+    /// 20 m/s, so the points yield after a few steps and keep yielding.
+    pub fn velocity(&self) -> Vec<f64> {
+        let mut v = vec![0.0; 6 * self.x0.len()];
+        let pi = std::f64::consts::PI;
+        for (i, p) in self.x0.iter().enumerate() {
+            v[6 * i] = 160.0 * (p[0] - 0.5);
+            v[6 * i + 1] = -40.0 * (p[1] - 0.5);
+            v[6 * i + 2] = 20.0 * (pi * p[0]).sin() * (pi * p[1]).sin();
+        }
+        v
+    }
+}
+
+/// Free explicit dynamics of a BT4 plate (central difference, no load).
+pub struct Bt4Explicit {
+    pub bt4: Bt4,
+    pub x: Vec<[f64; 3]>,
+    pub v: Vec<f64>,
+    pub du: Vec<f64>,
+    pub f: Vec<f64>,
+    pub inv_mass: Vec<f64>,
+    pub dt: f64,
+}
+
+impl Bt4Explicit {
+    pub fn new(plate: &Bt4Plate) -> Bt4Explicit {
+        let ne = plate.conn.len();
+        let bt4 = Bt4::new(plate.conn.clone(), vec![0.01; ne], steel(), Bt4Settings::default());
+        let nn = plate.x0.len();
+        let mut mass = vec![0.0; 6 * nn];
+        bt4.lumped_mass(&plate.x0, &mut mass);
+        let dt = 0.9 * bt4.stable_dt(&plate.x0);
+        Bt4Explicit {
+            bt4,
+            x: plate.x0.clone(),
+            v: plate.velocity(),
+            du: vec![0.0; 6 * nn],
+            f: vec![0.0; 6 * nn],
+            inv_mass: mass.iter().map(|m| 1.0 / m).collect(),
+            dt,
+        }
+    }
+
+    /// One whole step: `Δu = dt v`, `x += Δu`, internal forces, commit, `v -= dt f / m`, the
+    /// next stable step.
+    pub fn step(&mut self) {
+        use rayon::prelude::*;
+        let dt = self.dt;
+        (self.x.par_iter_mut(), self.du.par_chunks_mut(6), self.v.par_chunks(6))
+            .into_par_iter()
+            .with_min_len(4096)
+            .for_each(|(x, du, v)| {
+                for k in 0..6 {
+                    du[k] = dt * v[k];
+                }
+                for k in 0..3 {
+                    x[k] += du[k];
+                }
+            });
+        self.f.par_iter_mut().with_min_len(4096).for_each(|f| *f = 0.0);
+        self.bt4.internal_force(&self.x, &self.du, &mut self.f);
+        self.bt4.commit();
+        (self.v.par_iter_mut(), self.f.par_iter(), self.inv_mass.par_iter())
+            .into_par_iter()
+            .with_min_len(4096)
+            .for_each(|(v, f, im)| *v -= dt * f * im);
+        self.dt = 0.9 * self.bt4.stable_dt(&self.x);
+    }
+
+    fn plastic(&self) -> Vec<f64> {
+        let np = self.bt4.settings.rule.len();
+        (0..self.bt4.n_elements())
+            .flat_map(|e| (0..np).map(move |p| (e, p)))
+            .map(|(e, p)| self.bt4.plastic_strain(e, p))
+            .collect()
+    }
+}
+
+/// Times whole explicit steps of BT4 + J2 (5 points, plane-stress return) on a plate of about
+/// `elements` elements, natural and shuffled order, on each thread count.
+pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Result<ExplicitBench> {
+    anyhow::ensure!(elements > 0 && steps > 0, "--elements and the steps must be positive");
+    anyhow::ensure!(
+        !threads.is_empty() && threads.iter().all(|&t| t > 0),
+        "--threads must list thread counts of at least 1, e.g. 1,2"
+    );
+    let mut runs = Vec::new();
+    let mut info = None;
+    let mut rust_end: Option<Vec<[f64; 3]>> = None;
+    const WARMUP: usize = 20;
+    for (order, shuffled) in [("natural", false), ("shuffled", true)] {
+        let plate = Bt4Plate::new(elements, shuffled);
+        for &t in threads {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
+            let mut sim = Bt4Explicit::new(&plate);
+            let (rate, cpu_rate, plastic) = pool.install(|| {
+                for _ in 0..WARMUP {
+                    sim.step();
+                }
+                let alpha0 = sim.plastic();
+                let (t0, c0) = (Instant::now(), process_cpu_seconds());
+                for _ in 0..steps {
+                    sim.step();
+                }
+                let secs = t0.elapsed().as_secs_f64();
+                let cpu = process_cpu_seconds() - c0;
+                let alpha = sim.plastic();
+                let yielding = alpha.iter().zip(&alpha0).filter(|(a, b)| a > b).count();
+                let updates = (sim.bt4.n_elements() * steps) as f64;
+                (updates / secs, updates / cpu, yielding as f64 / alpha.len() as f64)
+            });
+            if !shuffled && rust_end.is_none() {
+                rust_end = Some(sim.x.clone());
+            }
+            let s = &sim.bt4.settings;
+            info.get_or_insert((
+                sim.bt4.n_elements(),
+                s.rule.len(),
+                s.newton,
+                sim.bt4.bytes_per_element(),
+            ));
+            runs.push(ExplicitRun {
+                order,
+                threads: t,
+                plastic_fraction: plastic,
+                element_updates_per_s: rate,
+                element_updates_per_s_per_core: rate / t as f64,
+                ns_per_element_update: 1e9 / rate,
+                element_updates_per_cpu_s: cpu_rate,
+            });
+        }
+    }
+    let (ne, np, newton, bytes) = info.expect("one run at least");
+    let natural = Bt4Plate::new(elements, false);
+    let c_reference = match c_reference(&natural, WARMUP, steps) {
+        Ok((secs, cpu, x_c)) => {
+            let rate = (ne * steps) as f64 / secs;
+            let cpu_rate = (ne * steps) as f64 / cpu;
+            let x_r = rust_end.expect("a natural run");
+            let scale = x_r.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            let diff = x_r
+                .iter()
+                .flatten()
+                .zip(x_c.iter().flatten())
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            CReference {
+                unavailable: None,
+                element_updates_per_s: Some(rate),
+                element_updates_per_cpu_s: Some(cpu_rate),
+                rust_over_c: Some(runs[0].element_updates_per_s_per_core / rate),
+                rust_over_c_cpu: Some(runs[0].element_updates_per_cpu_s / cpu_rate),
+                position_difference: Some(diff / scale),
+            }
+        }
+        Err(e) => CReference {
+            unavailable: Some(format!("{e:#}")),
+            element_updates_per_s: None,
+            element_updates_per_cpu_s: None,
+            rust_over_c: None,
+            rust_over_c_cpu: None,
+            position_difference: None,
+        },
+    };
+    let speedup = |order: &str| {
+        let r = |t: usize| {
+            runs.iter()
+                .find(|r| r.order == order && r.threads == t)
+                .map(|r| r.element_updates_per_s)
+        };
+        r(1).zip(r(2)).map(|(one, two)| two / one)
+    };
+    Ok(ExplicitBench {
         elements: ne,
         steps,
         thickness_points: np,
         newton_updates: newton,
         lanes: LANES,
-        plastic_fraction: plastic as f64 / (ne * np) as f64,
-        element_updates_per_s_per_core: updates / secs,
-        ns_per_element_update: 1e9 * secs / updates,
-    }
+        simd_path: SimdPath::detected().name(),
+        bytes_per_element: bytes,
+        element_updates_per_s_per_core: runs[0].element_updates_per_s_per_core,
+        plastic_fraction: runs[0].plastic_fraction,
+        speedup_2_threads_natural: speedup("natural"),
+        speedup_2_threads_shuffled: speedup("shuffled"),
+        runs,
+        c_reference,
+    })
+}
+
+/// Runs the C reference on `plate` (`warmup` untimed and `steps` timed steps): its seconds
+/// and end positions. The input file: 8 `u64` (magic, nodes, elements, points, Newton
+/// updates, warm-up steps, timed steps, scaled rotary inertia), 15 `f64` (`C00 C01 C22 κG E
+/// c1 c2 H σy r tol c 12κG ρ dt0`), the points and weights, positions, velocities and inverse
+/// masses per node, thickness and connectivity (`u32`) per element.
+fn c_reference(
+    plate: &Bt4Plate,
+    warmup: usize,
+    steps: usize,
+) -> anyhow::Result<(f64, f64, Vec<[f64; 3]>)> {
+    use crate::elements::section::SHEAR_FACTOR;
+    use crate::elements::RotaryInertia;
+    use anyhow::Context;
+    let exe = env!("BT4_C_REFERENCE");
+    anyhow::ensure!(!exe.is_empty(), "bench/bt4.c was not compiled (no C compiler at build time)");
+    let sim = Bt4Explicit::new(plate);
+    let (bt4, set) = (&sim.bt4, &sim.bt4.settings);
+    let m = bt4.materials()[0];
+    let el = m.elastic;
+    let c = el.tangent_plane_stress();
+    let ret = m.plane_stress_constants::<f64>();
+    let mut buf: Vec<u8> = Vec::new();
+    let header = [
+        0x3146_4552_4334_4254u64,
+        plate.x0.len() as u64,
+        plate.conn.len() as u64,
+        set.rule.len() as u64,
+        set.newton as u64,
+        warmup as u64,
+        steps as u64,
+        u64::from(set.rotary == RotaryInertia::Scaled),
+    ];
+    header.iter().for_each(|v| buf.extend(v.to_le_bytes()));
+    let consts = [
+        c[0][0],
+        c[0][1],
+        c[2][2],
+        SHEAR_FACTOR * el.shear_modulus(),
+        el.e,
+        ret.c1,
+        ret.c2,
+        ret.h,
+        ret.sigma_y,
+        set.hourglass,
+        set.return_tol,
+        el.plate_wave_speed(),
+        12.0 * SHEAR_FACTOR * el.shear_modulus(),
+        el.rho,
+        sim.dt,
+    ];
+    let reals = consts
+        .iter()
+        .chain(&set.rule.points)
+        .chain(&set.rule.weights)
+        .chain(sim.x.iter().flatten())
+        .chain(&sim.v)
+        .chain(&sim.inv_mass)
+        .chain(&bt4.thickness);
+    reals.for_each(|v| buf.extend(v.to_le_bytes()));
+    bt4.conn.iter().flatten().for_each(|v| buf.extend(v.to_le_bytes()));
+    let dir = std::env::temp_dir();
+    let tag = format!("bt4-c-{}", std::process::id());
+    let (input, output) = (dir.join(format!("{tag}.in")), dir.join(format!("{tag}.out")));
+    std::fs::write(&input, &buf).with_context(|| format!("writing {}", input.display()))?;
+    let run = std::process::Command::new(exe).arg(&input).arg(&output).output();
+    let _ = std::fs::remove_file(&input);
+    let run = run.with_context(|| format!("running {exe}"))?;
+    anyhow::ensure!(run.status.success(), "{exe}: {}", String::from_utf8_lossy(&run.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout)?;
+    let secs = report["seconds"].as_f64().context("the C reference printed no seconds")?;
+    let cpu = report["cpu_seconds"].as_f64().context("the C reference printed no cpu_seconds")?;
+    let bytes = std::fs::read(&output).with_context(|| format!("reading {}", output.display()))?;
+    let _ = std::fs::remove_file(&output);
+    anyhow::ensure!(
+        bytes.len() == 24 * plate.x0.len(),
+        "the C reference wrote {} bytes",
+        bytes.len()
+    );
+    let x = bytes
+        .chunks_exact(24)
+        .map(|p| {
+            std::array::from_fn(|k| f64::from_le_bytes(p[8 * k..8 * k + 8].try_into().unwrap()))
+        })
+        .collect();
+    Ok((secs, cpu, x))
+}
+
+/// Processor time of this process (user + system, all threads) from `/proc/self/stat`, in
+/// seconds (ticks of 1/100 s); 0 where there is no `/proc`.
+fn process_cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name (which may hold spaces) start at the state, field 3.
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    // utime and stime are fields 14 and 15: 11 and 12 after the state.
+    (ticks(11) + ticks(12)) / 100.0
 }
 
 /// Times Newmark steps of a clamped `n x n` MITC4 plate under a suddenly applied pressure.
@@ -210,9 +509,9 @@ pub fn implicit(n: usize, steps: usize) -> anyhow::Result<ImplicitBench> {
 }
 
 /// Runs both benches; `quick` shrinks them (tests).
-pub fn run(quick: bool) -> anyhow::Result<BenchReport> {
-    let (n, steps) = if quick { (20, 5) } else { (100, 200) };
-    let explicit = explicit(n, steps);
+pub fn run(quick: bool, elements: usize, threads: &[usize]) -> anyhow::Result<BenchReport> {
+    let explicit =
+        if quick { explicit(400, 5, threads)? } else { explicit(elements, 100, threads)? };
     let implicit = if quick { implicit(10, 2)? } else { implicit(100, 3)? };
     Ok(BenchReport { explicit_bt4: explicit, implicit_newmark: Some(implicit) })
 }

@@ -36,6 +36,12 @@ enum Command {
         /// Small sizes (a smoke test, not a measurement).
         #[arg(long)]
         quick: bool,
+        /// Elements of the explicit BT4 plate (about; a square grid).
+        #[arg(long, default_value_t = 100_000)]
+        elements: usize,
+        /// Thread counts of the explicit bench.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
     },
 }
 
@@ -81,10 +87,12 @@ fn main() {
             .map_err(anyhow::Error::from)
             .and_then(|case| structure_solver::check::check(&case))
             .map(|summary| print!("{summary}")),
-        Command::Bench { quick } => structure_solver::bench::run(quick).and_then(|r| {
-            println!("{}", serde_json::to_string_pretty(&r)?);
-            Ok(())
-        }),
+        Command::Bench { quick, elements, threads } => {
+            structure_solver::bench::run(quick, elements, &threads).and_then(|r| {
+                println!("{}", serde_json::to_string_pretty(&r)?);
+                Ok(())
+            })
+        }
     };
     if let Err(e) = result {
         eprintln!("structure-solver: {e:#}");

@@ -1,7 +1,8 @@
 //! Materials: elastic stress and tangent against finite differences of the energy, J2 consistent
 //! tangents against finite differences of the return maps, J2 uniaxial loading, unloading and
-//! reverse yield against the closed form for the 3D and the plane-stress returns, and the
-//! through-thickness rules.
+//! reverse yield against the closed form for the 3D and the plane-stress returns, the
+//! safeguarded fallback of the plane-stress return on increments 3 Newton updates cannot
+//! handle, and the through-thickness rules.
 
 use structure_solver::material::j2::{J2State3d, J2StatePlane};
 use structure_solver::material::{Elastic, ThicknessRule, J2};
@@ -279,4 +280,53 @@ fn thickness_rules_integrate_polynomials_and_give_the_plastic_moment_factor() {
     let f5 = ThicknessRule::gauss(5).plastic_moment_factor();
     assert!((f5 - 0.9448).abs() < 1e-4, "{f5}");
     assert!(ThicknessRule::gauss(8).plastic_moment_factor() > 0.98);
+}
+
+/// `f = ½ σᵀPσ - ⅓ κ(α)²` of a plane-stress return's result, relative to `κ²`.
+fn yield_residual(m: &J2, r: &structure_solver::material::PlaneStressReturn) -> f64 {
+    let s = r.sigma;
+    let xi2 = 2.0 / 3.0 * (s[0] * s[0] + s[1] * s[1] - s[0] * s[1]) + 2.0 * s[2] * s[2];
+    let kappa = m.yield_stress(r.alpha);
+    (0.5 * xi2 - kappa * kappa / 3.0) / (kappa * kappa)
+}
+
+#[test]
+fn plane_stress_return_falls_back_when_three_updates_are_not_enough() {
+    use structure_solver::material::lanes::Lanes;
+    let m = steel();
+    let sy = m.sigma_y;
+    // Trials far outside the surface (a large step, a shock): 3 Newton updates from the
+    // radial-return estimate leave the yield condition violated.
+    let trials = [
+        [30.0 * sy, 29.0 * sy, 0.0],
+        [10.0 * sy, 9.0 * sy, 0.1 * sy],
+        [-5.0 * sy, -5.0 * sy, 0.0],
+        [200.0 * sy, 190.0 * sy, 5.0 * sy],
+    ];
+    for trial in trials {
+        let three = m.return_plane_stress(trial, 0.0, 3, 0.0);
+        let safe = m.return_plane_stress(trial, 0.0, 3, 1e-12);
+        let (r3, rs) = (yield_residual(&m, &three), yield_residual(&m, &safe));
+        println!(
+            "trial {:?} σy: 3 updates f/κ² = {r3:.2e}, with fallback {rs:.2e}",
+            trial.map(|t| t / sy)
+        );
+        assert!(r3.abs() > 1e-7, "3 updates are enough here: {r3:e}");
+        assert!(rs.abs() <= 1e-11, "the fallback must satisfy the yield condition: {rs:e}");
+        assert!(safe.dgamma > 0.0 && safe.alpha > 0.0);
+    }
+    // Lane by lane: a hard lane among easy and elastic ones gives each lane the result of the
+    // same return on its own.
+    let easy = [1.1 * sy, 0.2 * sy, 0.1 * sy];
+    let elastic = [0.3 * sy, 0.1 * sy, 0.0];
+    let lanes: [[f64; 3]; 4] = [easy, trials[0], elastic, trials[2]];
+    let t: [Lanes<4>; 3] = std::array::from_fn(|k| Lanes(lanes.map(|l| l[k])));
+    let r = m.return_plane_stress(t, Lanes([1e-3; 4]), 3, 1e-12);
+    for (l, trial) in lanes.iter().enumerate() {
+        let one = m.return_plane_stress(*trial, 1e-3, 3, 1e-12);
+        for k in 0..3 {
+            assert_eq!(r.sigma[k].0[l], one.sigma[k], "lane {l} component {k}");
+        }
+        assert_eq!(r.alpha.0[l], one.alpha, "lane {l} plastic strain");
+    }
 }

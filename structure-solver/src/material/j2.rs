@@ -101,13 +101,8 @@ impl J2 {
     }
 
     /// Plane-stress closest point projection from a trial stress `[σxx, σyy, σxy]` (Simo-Taylor
-    /// 1986; Simo-Hughes Box 3.3), at most `max_newton` Newton updates of `Δγ` on
-    /// `f(Δγ) = ½ ξ² - ⅓ κ²`, `ξ² = σ(Δγ)ᵀ P σ(Δγ)`, stopping early when every lane satisfies
-    /// `|f| <= tol κ²`.
-    ///
-    /// In the common eigenbasis of `C` and `P`, `σ(Δγ) = (1 + Δγ C P)⁻¹ σ_trial` is diagonal:
-    /// the mean part `(σxx+σyy)` scales by `1/(1 + E Δγ / (3(1-ν)))`, the deviatoric parts
-    /// `(σyy-σxx)/2, σxy` by `1/(1 + 2 G Δγ)`.
+    /// 1986; Simo-Hughes Box 3.3): see [`return_plane_stress_with`]; the constants of this
+    /// material on every lane.
     #[inline(always)]
     pub fn return_plane_stress<R: Real>(
         &self,
@@ -116,56 +111,139 @@ impl J2 {
         max_newton: usize,
         tol: f64,
     ) -> PlaneStressReturn<R> {
-        let e = self.elastic.e;
-        let g = self.elastic.shear_modulus();
-        let c1 = R::splat(e / (3.0 * (1.0 - self.elastic.nu)));
-        let c2 = R::splat(2.0 * g);
-        let (one, h, sy) = (R::splat(1.0), R::splat(self.h), R::splat(self.sigma_y));
-        let mean = trial[0] + trial[1];
-        let half_diff = (trial[1] - trial[0]) * R::splat(0.5);
-        let a1 = mean * mean * R::splat(1.0 / 6.0);
-        let a2 = half_diff * half_diff * R::splat(2.0) + trial[2] * trial[2] * R::splat(2.0);
-        let kappa_n = sy + h * alpha;
-        let f_trial = R::splat(0.5) * (a1 + a2) - R::splat(1.0 / 3.0) * kappa_n * kappa_n;
-        let yielding = f_trial.gt(R::splat(0.0));
-        let mut dgamma = R::splat(0.0);
-        if R::any(yielding) {
-            // Start from the radial-return estimate (every component scaled by 1/(1 + 2GΔγ)):
-            // ξ_tr (1 - ⅔ H Δγ) = sqrt(⅔) κ_n (1 + 2 G Δγ).
-            let xi_tr = (a1 + a2).sqrt();
-            let k_n = R::splat(SQRT_2_3) * kappa_n;
-            let guess = (xi_tr - k_n) / (R::splat(2.0 / 3.0) * h * xi_tr + c2 * k_n);
-            dgamma = R::select(yielding, guess, dgamma);
-            let tol = R::splat(tol);
-            for _ in 0..max_newton {
-                let d1 = one + c1 * dgamma;
-                let d2 = one + c2 * dgamma;
-                let (i1, i2) = (one / d1, one / d2);
-                let (q1, q2) = (a1 * i1 * i1, a2 * i2 * i2);
-                let xi2 = q1 + q2;
-                let xi = xi2.sqrt();
-                let dxi2 = R::splat(-2.0) * (q1 * c1 * i1 + q2 * c2 * i2);
-                let kappa = kappa_n + h * R::splat(SQRT_2_3) * dgamma * xi;
-                let f = R::splat(0.5) * xi2 - R::splat(1.0 / 3.0) * kappa * kappa;
-                if !R::any((f.abs() - tol * kappa * kappa).gt(R::splat(0.0))) {
-                    break;
-                }
-                // dκ/dΔγ = H sqrt(2/3) (ξ + Δγ ξ'), ξ' = (ξ²)' / (2ξ).
-                let dkappa = h * R::splat(SQRT_2_3) * (xi + dgamma * dxi2 * R::splat(0.5) / xi);
-                let df = R::splat(0.5) * dxi2 - R::splat(2.0 / 3.0) * kappa * dkappa;
-                dgamma = R::select(yielding, dgamma - f / df, dgamma);
-            }
-        }
-        let s1 = mean / (one + c1 * dgamma);
-        let s2 = half_diff / (one + c2 * dgamma);
-        let sxy = trial[2] / (one + c2 * dgamma);
-        let sigma = [s1 * R::splat(0.5) - s2, s1 * R::splat(0.5) + s2, sxy];
-        let xi =
-            (s1 * s1 * R::splat(1.0 / 6.0) + s2 * s2 * R::splat(2.0) + sxy * sxy * R::splat(2.0))
-                .sqrt();
-        PlaneStressReturn { sigma, alpha: alpha + R::splat(SQRT_2_3) * dgamma * xi, dgamma }
+        return_plane_stress_with(&self.plane_stress_constants(), trial, alpha, max_newton, tol)
     }
 
+    /// The constants of the plane-stress return of this material, splat on every lane.
+    #[inline(always)]
+    pub fn plane_stress_constants<R: Real>(&self) -> PlaneStressConstants<R> {
+        let g = self.elastic.shear_modulus();
+        PlaneStressConstants {
+            c1: R::splat(self.elastic.e / (3.0 * (1.0 - self.elastic.nu))),
+            c2: R::splat(2.0 * g),
+            h: R::splat(self.h),
+            sigma_y: R::splat(self.sigma_y),
+        }
+    }
+}
+
+/// The material constants the plane-stress return reads, per lane (elements of a block may
+/// have different materials): the eigenvalues `c1 = E / (3(1-ν))`, `c2 = 2G` of `C P`, the
+/// plastic modulus and the initial yield stress.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneStressConstants<R> {
+    pub c1: R,
+    pub c2: R,
+    pub h: R,
+    pub sigma_y: R,
+}
+
+/// Updates of the safeguarded fallback of the plane-stress return: bisection alone halves the
+/// bracket each update, so this many reach round-off from any bracket.
+pub const FALLBACK_UPDATES: usize = 120;
+
+/// Plane-stress closest point projection from a trial stress `[σxx, σyy, σxy]` (Simo-Taylor
+/// 1986; Simo-Hughes Box 3.3): Newton updates of `Δγ` on `f(Δγ) = ½ ξ² - ⅓ κ²`,
+/// `ξ² = σ(Δγ)ᵀ P σ(Δγ)`, `κ = κ_n + H sqrt(⅔) Δγ ξ`, from the radial-return estimate.
+///
+/// At most `max_newton` plain Newton updates, stopping early when every lane satisfies
+/// `|f| <= tol κ²`. With `tol > 0`, lanes still outside the tolerance then continue with a
+/// safeguarded iteration (at most [`FALLBACK_UPDATES`]): `f` falls from `f(0) > 0` to
+/// `f(Δγ_max) <= 0`, `Δγ_max = (ξ_tr / (sqrt(⅔) κ_n) - 1) / min(c1, c2)` (as `ξ <= ξ_tr /
+/// (1 + min(c1, c2) Δγ)` and `κ >= κ_n` for `H >= 0`), the bracket shrinks on the sign of `f`
+/// and a Newton step leaving it is replaced by its midpoint. With `tol = 0` exactly
+/// `max_newton` updates are made.
+///
+/// In the common eigenbasis of `C` and `P`, `σ(Δγ) = (1 + Δγ C P)⁻¹ σ_trial` is diagonal: the
+/// mean part `(σxx+σyy)` scales by `1/(1 + c1 Δγ)`, the deviatoric parts `(σyy-σxx)/2, σxy`
+/// by `1/(1 + c2 Δγ)`.
+#[inline(always)]
+pub fn return_plane_stress_with<R: Real>(
+    m: &PlaneStressConstants<R>,
+    trial: [R; 3],
+    alpha: R,
+    max_newton: usize,
+    tol: f64,
+) -> PlaneStressReturn<R> {
+    let (c1, c2, h) = (m.c1, m.c2, m.h);
+    let (zero, one) = (R::splat(0.0), R::splat(1.0));
+    let mean = trial[0] + trial[1];
+    let half_diff = (trial[1] - trial[0]) * R::splat(0.5);
+    let a1 = mean * mean * R::splat(1.0 / 6.0);
+    let a2 = half_diff * half_diff * R::splat(2.0) + trial[2] * trial[2] * R::splat(2.0);
+    let kappa_n = m.sigma_y + h * alpha;
+    let f_trial = R::splat(0.5) * (a1 + a2) - R::splat(1.0 / 3.0) * kappa_n * kappa_n;
+    let yielding = f_trial.gt(zero);
+    let mut dgamma = zero;
+    if R::any(yielding) {
+        // f, f' and κ at Δγ.
+        let eval = |dgamma: R| {
+            let (i1, i2) = (one / (one + c1 * dgamma), one / (one + c2 * dgamma));
+            let (q1, q2) = (a1 * i1 * i1, a2 * i2 * i2);
+            let xi2 = q1 + q2;
+            let xi = xi2.sqrt();
+            let dxi2 = R::splat(-2.0) * (q1 * c1 * i1 + q2 * c2 * i2);
+            let kappa = kappa_n + h * R::splat(SQRT_2_3) * dgamma * xi;
+            let f = R::splat(0.5) * xi2 - R::splat(1.0 / 3.0) * kappa * kappa;
+            // dκ/dΔγ = H sqrt(2/3) (ξ + Δγ ξ'), ξ' = (ξ²)' / (2ξ).
+            let dkappa = h * R::splat(SQRT_2_3) * (xi + dgamma * dxi2 * R::splat(0.5) / xi);
+            let df = R::splat(0.5) * dxi2 - R::splat(2.0 / 3.0) * kappa * dkappa;
+            (f, df, kappa)
+        };
+        // Lanes to update: yielding and outside the tolerance; a lane stops when it converges,
+        // so its result does not depend on the other lanes of its block.
+        let active = |f: R, kappa: R| {
+            let excess = R::select(yielding, f.abs() - R::splat(tol) * kappa * kappa, -one);
+            excess.gt(zero)
+        };
+        // Start from the radial-return estimate (every component scaled by 1/(1 + 2GΔγ)):
+        // ξ_tr (1 - ⅔ H Δγ) = sqrt(⅔) κ_n (1 + 2 G Δγ).
+        let xi_tr = (a1 + a2).sqrt();
+        let k_n = R::splat(SQRT_2_3) * kappa_n;
+        let guess = (xi_tr - k_n) / (R::splat(2.0 / 3.0) * h * xi_tr + c2 * k_n);
+        dgamma = R::select(yielding, guess, dgamma);
+        let (mut f, mut df, mut kappa) = eval(dgamma);
+        for i in 0..max_newton {
+            let act = active(f, kappa);
+            if !R::any(act) {
+                break;
+            }
+            dgamma = R::select(act, dgamma - f / df, dgamma);
+            if i + 1 < max_newton || tol > 0.0 {
+                (f, df, kappa) = eval(dgamma);
+            }
+        }
+        if tol > 0.0 && R::any(active(f, kappa)) {
+            let mut lo = zero;
+            let mut hi = (xi_tr / k_n - one) / c1.min(c2);
+            for _ in 0..FALLBACK_UPDATES {
+                let act = active(f, kappa);
+                if !R::any(act) {
+                    break;
+                }
+                // Shrink the bracket on the sign of f.
+                let above = f.gt(zero);
+                lo = R::select(above, dgamma, lo);
+                hi = R::select(above, hi, dgamma);
+                let mid = (lo + hi) * R::splat(0.5);
+                let newton = dgamma - f / df;
+                let inside = R::select(newton.gt(lo), newton, mid);
+                let step = R::select(hi.gt(inside), inside, mid);
+                dgamma = R::select(act, step, dgamma);
+                (f, df, kappa) = eval(dgamma);
+            }
+        }
+    }
+    let s1 = mean / (one + c1 * dgamma);
+    let s2 = half_diff / (one + c2 * dgamma);
+    let sxy = trial[2] / (one + c2 * dgamma);
+    let sigma = [s1 * R::splat(0.5) - s2, s1 * R::splat(0.5) + s2, sxy];
+    let xi = (s1 * s1 * R::splat(1.0 / 6.0) + s2 * s2 * R::splat(2.0) + sxy * sxy * R::splat(2.0))
+        .sqrt();
+    PlaneStressReturn { sigma, alpha: alpha + R::splat(SQRT_2_3) * dgamma * xi, dgamma }
+}
+
+impl J2 {
     /// Consistent tangent of the plane-stress return (derived from the linearised consistency
     /// condition; Simo-Hughes eq. 3.4.x): with `Ξ = (C⁻¹ + Δγ P)⁻¹`, `n = P σ`,
     /// `θ = 1 - ⅔ H Δγ`, `β = ⅔ H ξ² / θ`: `C_ep = Ξ - (Ξ n)(Ξ n)ᵀ / (nᵀ Ξ n + β)`.

@@ -11,7 +11,10 @@ pub mod lanes;
 pub mod thickness;
 
 pub use elastic::Elastic;
-pub use j2::{J2State3d, J2StatePlane, PlaneStressReturn, Return3d, J2};
+pub use j2::{
+    return_plane_stress_with, J2State3d, J2StatePlane, PlaneStressConstants, PlaneStressReturn,
+    Return3d, J2,
+};
 pub use thickness::ThicknessRule;
 
 /// A shell or solid material as read from a case: elastic, or J2 when a yield stress is given.

@@ -1,0 +1,303 @@
+//! The explicit BT4 loop over threads and vector units (DESIGN §6, "Speed").
+//!
+//! One pass in two phases, both over threads:
+//! 1. blocks of [`LANES`] elements, [`BLOCKS_PER_TASK`] blocks a task: gather the block's
+//!    nodes, run the kernel, write the trial state and the element forces (24 per element) to
+//!    a work array, so no two tasks write the same memory;
+//! 2. nodes, a node's force summing its elements' contributions in ascending element order
+//!    (a node-to-element incidence table built once), exactly the order of a serial scatter.
+//!
+//! So the forces are bitwise independent of the thread count and of rayon's splitting.
+//!
+//! The vector width is chosen at run time ([`SimdPath`]): the block loop is compiled for
+//! AVX-512 (x86-64-v4), AVX2 + FMA (x86-64-v3) and the baseline (SSE2) through `pulp`, and
+//! the widest the processor has runs. The kernel never asks for fused multiply-adds, so every
+//! path does the same IEEE operations and gives the same bits.
+
+use rayon::prelude::*;
+
+use super::kernel::{element_block, BlockState, Constants, V};
+use super::{LANES, N_HOURGLASS, N_STRESS};
+use crate::material::lanes::{Lanes, Real};
+
+/// Blocks of elements per task of the first phase.
+pub const BLOCKS_PER_TASK: usize = 16;
+/// Nodes per task of the second phase.
+const NODES_PER_TASK: usize = 2048;
+/// Element forces per element in the work array: 6 per node, `[node][dof]`.
+const F_PER_ELEMENT: usize = 24;
+
+/// An instruction set the block loop is compiled for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimdPath {
+    /// x86-64-v4: AVX-512 (F, BW, CD, DQ, VL), a block of 8 `f64` in one register.
+    Avx512,
+    /// x86-64-v3: AVX2 and FMA.
+    Avx2Fma,
+    /// The baseline of the target (SSE2 on x86-64).
+    Scalar,
+}
+
+impl SimdPath {
+    pub const ALL: [SimdPath; 3] = [SimdPath::Avx512, SimdPath::Avx2Fma, SimdPath::Scalar];
+
+    /// The widest path this processor runs.
+    pub fn detected() -> SimdPath {
+        Self::ALL.into_iter().find(|p| p.is_supported()).unwrap_or(SimdPath::Scalar)
+    }
+
+    /// `true` when this processor runs the path.
+    pub fn is_supported(self) -> bool {
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 => pulp::x86::V4::try_new().is_some(),
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2Fma => pulp::x86::V3::try_new().is_some(),
+            SimdPath::Scalar => true,
+            #[allow(unreachable_patterns)]
+            _ => false,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SimdPath::Avx512 => "avx512",
+            SimdPath::Avx2Fma => "avx2+fma",
+            SimdPath::Scalar => "scalar",
+        }
+    }
+
+    /// Runs `op` compiled for this path; `None` when the processor lacks it.
+    fn run<Op: pulp::WithSimd>(self, op: Op) -> Option<Op::Output> {
+        use pulp::Simd;
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 => pulp::x86::V4::try_new().map(|s| Simd::vectorize(s, op)),
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2Fma => pulp::x86::V3::try_new().map(|s| Simd::vectorize(s, op)),
+            SimdPath::Scalar => Some(Simd::vectorize(pulp::Scalar::new(), op)),
+            #[allow(unreachable_patterns)]
+            _ => None,
+        }
+    }
+}
+
+/// Node-to-element incidence: the contributions `(element * 4 + local node)` of node `n` are
+/// `entries[start[n]..start[n + 1]]`, ascending.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Incidence {
+    start: Vec<u32>,
+    entries: Vec<u32>,
+}
+
+impl Incidence {
+    pub fn new(conn: &[[u32; 4]], n_nodes: usize) -> Self {
+        let mut start = vec![0u32; n_nodes + 1];
+        for c in conn {
+            for &n in c {
+                start[n as usize + 1] += 1;
+            }
+        }
+        for i in 0..n_nodes {
+            start[i + 1] += start[i];
+        }
+        let mut next = start.clone();
+        let mut entries = vec![0u32; 4 * conn.len()];
+        for (e, c) in conn.iter().enumerate() {
+            for (i, &n) in c.iter().enumerate() {
+                entries[next[n as usize] as usize] = (4 * e + i) as u32;
+                next[n as usize] += 1;
+            }
+        }
+        Incidence { start, entries }
+    }
+
+    pub fn n_nodes(&self) -> usize {
+        self.start.len().saturating_sub(1)
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        4 * (self.start.len() + self.entries.len())
+    }
+}
+
+/// The inputs every task reads.
+struct Shared<'a> {
+    bt4: &'a Bt4View<'a>,
+    x_end: &'a [[f64; 3]],
+    du: &'a [f64],
+}
+
+/// The parts of a [`Bt4`] the kernel reads.
+pub(super) struct Bt4View<'a> {
+    pub conn: &'a [[u32; 4]],
+    pub thickness: &'a [f64],
+    pub constants: &'a [Constants<f64>],
+    pub material_of: &'a [u16],
+    pub settings: &'a super::Bt4Settings,
+}
+
+/// The blocks of one task.
+struct BlockTask<'a> {
+    shared: &'a Shared<'a>,
+    first_block: usize,
+    stress_old: &'a [f64],
+    alpha_old: &'a [f64],
+    hg_old: &'a [f64],
+    stress_new: &'a mut [f64],
+    alpha_new: &'a mut [f64],
+    hg_new: &'a mut [f64],
+    forces: &'a mut [f64],
+}
+
+impl pulp::WithSimd for BlockTask<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        self.run();
+    }
+}
+
+impl BlockTask<'_> {
+    #[inline(always)]
+    fn run(self) {
+        let Shared { bt4, x_end, du } = *self.shared;
+        let np = bt4.settings.rule.len();
+        let ne = bt4.conn.len();
+        let (ns, na) = (np * N_STRESS * LANES, np * LANES);
+        let nh = N_HOURGLASS * LANES;
+        let n_blocks = self.forces.len() / (LANES * F_PER_ELEMENT);
+        for j in 0..n_blocks {
+            let e0 = (self.first_block + j) * LANES;
+            let valid = (ne - e0).min(LANES);
+            // Gather: padded lanes repeat the block's last element.
+            let el = |l: usize| e0 + l.min(valid - 1);
+            let mut xe = [[V::splat(0.0); 3]; 4];
+            let mut xm = xe;
+            let mut dv = [[V::splat(0.0); 6]; 4];
+            for l in 0..LANES {
+                let c = &bt4.conn[el(l)];
+                for i in 0..4 {
+                    let n = c[i] as usize;
+                    for k in 0..3 {
+                        xe[i][k].0[l] = x_end[n][k];
+                        xm[i][k].0[l] = x_end[n][k] - 0.5 * du[6 * n + k];
+                    }
+                    for k in 0..6 {
+                        dv[i][k].0[l] = du[6 * n + k];
+                    }
+                }
+            }
+            let h = Lanes(std::array::from_fn(|l| bt4.thickness[el(l)]));
+            let m0 = bt4.material_of[e0];
+            let mat = if (0..valid).all(|l| bt4.material_of[e0 + l] == m0) {
+                Constants::splat(&bt4.constants[m0 as usize])
+            } else {
+                Constants::gather(|l| &bt4.constants[bt4.material_of[el(l)] as usize])
+            };
+            let fe = element_block(
+                &mat,
+                bt4.settings,
+                &xe,
+                &xm,
+                &dv,
+                h,
+                BlockState {
+                    stress_old: &self.stress_old[j * ns..(j + 1) * ns],
+                    alpha_old: &self.alpha_old[j * na..(j + 1) * na],
+                    hg_old: &self.hg_old[j * nh..(j + 1) * nh],
+                    stress_new: &mut self.stress_new[j * ns..(j + 1) * ns],
+                    alpha_new: &mut self.alpha_new[j * na..(j + 1) * na],
+                    hg_new: &mut self.hg_new[j * nh..(j + 1) * nh],
+                },
+            );
+            let out = &mut self.forces[j * LANES * F_PER_ELEMENT..(j + 1) * LANES * F_PER_ELEMENT];
+            for l in 0..LANES {
+                for i in 0..4 {
+                    for d in 0..6 {
+                        out[(l * 4 + i) * 6 + d] = fe[i][d].0[l];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Work arrays of the loop.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Work {
+    pub incidence: Incidence,
+    /// Element forces, `[element][node][dof]`, padded to whole blocks.
+    pub forces: Vec<f64>,
+}
+
+impl Work {
+    pub fn bytes(&self) -> usize {
+        self.incidence.bytes() + 8 * self.forces.len()
+    }
+}
+
+/// Phase 1 and 2 of the module docs on `path`; `None` when the processor lacks it.
+pub(super) fn internal_force(
+    path: SimdPath,
+    bt4: &Bt4View<'_>,
+    state: (&super::Bt4State, &mut super::Bt4State),
+    work: &mut Work,
+    x_end: &[[f64; 3]],
+    du: &[f64],
+    f: &mut [f64],
+) -> Option<()> {
+    if !path.is_supported() {
+        return None;
+    }
+    let nn = x_end.len();
+    if work.incidence.n_nodes() != nn {
+        work.incidence = Incidence::new(bt4.conn, nn);
+    }
+    let nb = bt4.conn.len().div_ceil(LANES);
+    work.forces.resize(nb * LANES * F_PER_ELEMENT, 0.0);
+    let np = bt4.settings.rule.len();
+    let t = BLOCKS_PER_TASK;
+    let (old, new) = state;
+    let shared = Shared { bt4, x_end, du };
+    (
+        old.stress.par_chunks(t * np * N_STRESS * LANES),
+        old.alpha.par_chunks(t * np * LANES),
+        old.hourglass.par_chunks(t * N_HOURGLASS * LANES),
+        new.stress.par_chunks_mut(t * np * N_STRESS * LANES),
+        new.alpha.par_chunks_mut(t * np * LANES),
+        new.hourglass.par_chunks_mut(t * N_HOURGLASS * LANES),
+        work.forces.par_chunks_mut(t * LANES * F_PER_ELEMENT),
+    )
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(task, (so, ao, ho, sn, an, hn, fo))| {
+            let op = BlockTask {
+                shared: &shared,
+                first_block: task * t,
+                stress_old: so,
+                alpha_old: ao,
+                hg_old: ho,
+                stress_new: sn,
+                alpha_new: an,
+                hg_new: hn,
+                forces: fo,
+            };
+            path.run(op).expect("a supported path");
+        });
+    let (inc, forces) = (&work.incidence, &work.forces);
+    f[..6 * nn].par_chunks_mut(6 * NODES_PER_TASK).enumerate().for_each(|(task, fc)| {
+        let n0 = task * NODES_PER_TASK;
+        for (j, fnode) in fc.chunks_exact_mut(6).enumerate() {
+            let n = n0 + j;
+            for &c in &inc.entries[inc.start[n] as usize..inc.start[n + 1] as usize] {
+                let src = &forces[6 * c as usize..6 * c as usize + 6];
+                for d in 0..6 {
+                    fnode[d] += src[d];
+                }
+            }
+        }
+    });
+    Some(())
+}
