@@ -10,6 +10,7 @@ use serde::Serialize;
 
 use crate::assembly::{Curve, FeModel, Part};
 use crate::elements::ShellSection;
+use crate::linsolve::FreeSolver;
 use crate::mesh::generate::rectangle;
 use crate::model::Model;
 use crate::time::{Implicit, ImplicitScheme};
@@ -46,8 +47,28 @@ pub struct ImplicitRun {
     pub gmres_iterations: usize,
     pub seconds_per_step: f64,
     pub seconds_per_newton_iteration: f64,
+    /// Processor time of the process (all threads) per Newton iteration: on a machine shared
+    /// with other work, the single-thread figure bounds the wall time an idle machine gives.
+    pub cpu_seconds_per_newton_iteration: f64,
     /// Largest displacement magnitude at the end.
     pub max_displacement: f64,
+    /// One Newton iteration's linear-algebra pieces at the final configuration.
+    pub pieces: Pieces,
+}
+
+/// Seconds of the pieces of a Newton iteration (best of two), at the final configuration.
+#[derive(Debug, Serialize)]
+pub struct Pieces {
+    /// `Model::tangent` into triplets.
+    pub tangent: f64,
+    /// The triplets into the matrix through the scatter map (`FreeSolver::assemble`).
+    pub assemble: f64,
+    /// A fresh `LDLᵀ` of the symmetric part (`FreeSolver::factor`).
+    pub factorisation: f64,
+    /// A solve of the internal force vector preconditioned with the factor of this matrix,
+    /// and its GMRES iterations.
+    pub solve: f64,
+    pub solve_gmres_iterations: usize,
 }
 
 /// The clamped `n x n` MITC4 steel plate, 1 m square and 10 mm thick, under 1e5 Pa.
@@ -60,6 +81,59 @@ fn plate(n: usize) -> anyhow::Result<FeModel> {
     let cells: Vec<usize> = (0..mesh.cells.len()).collect();
     model.pressure(&cells, 1e5, Curve::Constant);
     Ok(model)
+}
+
+/// Processor seconds of this process so far (`/proc/self/stat` utime + stime, in the
+/// kernel's fixed 100 Hz `USER_HZ`); 0 where that file is missing.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return 0.0 };
+    // fields after the parenthesised command name; utime and stime are fields 14 and 15
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<f64> =
+        rest.split_whitespace().skip(11).take(2).filter_map(|v| v.parse().ok()).collect();
+    f.iter().sum::<f64>() / 100.0
+}
+
+/// Best of two timings of `f`.
+fn best_of_two(mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64> {
+    let mut best = f64::INFINITY;
+    for _ in 0..2 {
+        let t = Instant::now();
+        f()?;
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    Ok(best)
+}
+
+/// Times the pieces of a Newton iteration of `model` at its configuration (Newmark's
+/// Jacobian `K + 4/Δt² M`).
+fn pieces(model: &mut FeModel) -> anyhow::Result<Pieces> {
+    let mass = model.lumped_mass().to_vec();
+    let cm = 4.0 / (DT * DT);
+    let mut trip = Vec::new();
+    let tangent = best_of_two(|| {
+        trip.clear();
+        model.tangent(0.0, &mut trip);
+        Ok(())
+    })?;
+    let mut solver = FreeSolver::new(model);
+    solver.assemble(&trip, 1.0, Some((cm, &mass)))?; // the pattern and the map
+    let assemble = best_of_two(|| Ok(solver.assemble(&trip, 1.0, Some((cm, &mass)))?))?;
+    let factorisation =
+        best_of_two(|| Ok(solver.factor(&trip, 1.0, Some((cm, &mass))).map(drop)?))?;
+    let mut fi = vec![0.0; model.n_dof()];
+    model.internal_force(&mut fi);
+    // the factor of this matrix kept, then solves of it through the reuse path
+    solver.assemble(&trip, 1.0, Some((cm, &mass)))?;
+    solver.solve_in_place(solver.free.gather(&fi).as_mut())?;
+    let mut b = solver.free.gather(&fi);
+    let before = solver.stats();
+    let solve = best_of_two(|| {
+        b = solver.free.gather(&fi);
+        Ok(solver.solve_in_place(b.as_mut())?)
+    })?;
+    let its = solver.stats().since(&before).gmres_iterations / 2;
+    Ok(Pieces { tangent, assemble, factorisation, solve, solve_gmres_iterations: its })
 }
 
 /// One warm-up step and `steps` timed Newmark steps of `plate(n)` in a pool of `threads`.
@@ -82,6 +156,7 @@ fn run_one(
         im.step(&mut model, DT, None)?;
         let first = t0.elapsed().as_secs_f64();
         let (mut its, mut fact, mut gmres) = (0, 0, 0);
+        let cpu0 = cpu_seconds();
         let t0 = Instant::now();
         for _ in 0..steps {
             let info = im.step(&mut model, DT, None)?;
@@ -90,6 +165,7 @@ fn run_one(
             gmres += info.gmres_iterations;
         }
         let secs = t0.elapsed().as_secs_f64();
+        let cpu = cpu_seconds() - cpu0;
         let mut u = vec![[0.0; 3]; model.n_nodes()];
         model.displacement(&mut u);
         let umax =
@@ -104,7 +180,9 @@ fn run_one(
             gmres_iterations: gmres,
             seconds_per_step: secs / steps as f64,
             seconds_per_newton_iteration: secs / its.max(1) as f64,
+            cpu_seconds_per_newton_iteration: cpu / its.max(1) as f64,
             max_displacement: umax,
+            pieces: pieces(&mut model)?,
         };
         Ok((run, u))
     })
