@@ -10,6 +10,7 @@ use faer::sparse::linalg::cholesky::LdltRef;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::SparseColMatRef;
 use faer::{Conj, Mat, MatMut, Par, Side};
+use rayon::prelude::*;
 
 use super::gmres::{self, Limits, Outcome};
 use super::pattern::Pattern;
@@ -41,21 +42,34 @@ impl Jacobian {
     /// column (free-dof numbers).
     pub fn new(pattern: Arc<Pattern>, a: Vec<f64>) -> Result<Self, FactorError> {
         let p = &pattern;
-        if let Some(k) = a.iter().position(|v| !v.is_finite()) {
-            let j = p.col_ptr.partition_point(|&c| c <= k) - 1;
-            let err =
-                format!("non-finite matrix entry {} at free dofs ({}, {j})", a[k], p.row_idx[k]);
+        // one parallel pass over the columns: the first non-finite slot, the largest column
+        // sum, skew entry and entry (maxima: the same for any thread count)
+        let col = |j: usize| {
+            let (mut bad, mut sum, mut skew, mut amax) = (usize::MAX, 0.0, 0.0f64, 0.0f64);
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let v = a[k];
+                if !v.is_finite() && bad == usize::MAX {
+                    bad = k;
+                }
+                sum += v.abs();
+                skew = skew.max((v - a[p.transpose[k]]).abs());
+                amax = amax.max(v.abs());
+            }
+            (bad, sum, skew, amax)
+        };
+        let (bad, norm1, skew, amax) = (0..p.n).into_par_iter().with_min_len(256).map(col).reduce(
+            || (usize::MAX, 0.0, 0.0, 0.0),
+            |x, y| (x.0.min(y.0), x.1.max(y.1), x.2.max(y.2), x.3.max(y.3)),
+        );
+        if bad != usize::MAX {
+            let j = p.col_ptr.partition_point(|&c| c <= bad) - 1;
+            let err = format!(
+                "non-finite matrix entry {} at free dofs ({}, {j})",
+                a[bad], p.row_idx[bad]
+            );
             p.give(a);
             return Err(FactorError(err));
         }
-        let (mut skew, mut amax) = (0.0f64, 0.0f64);
-        for (&v, &t) in a.iter().zip(&p.transpose) {
-            skew = skew.max((v - a[t]).abs());
-            amax = amax.max(v.abs());
-        }
-        let norm1 = (0..p.n)
-            .map(|j| a[p.col_ptr[j]..p.col_ptr[j + 1]].iter().map(|v| v.abs()).sum())
-            .fold(0.0, f64::max);
         Ok(Jacobian { symmetric: skew <= 1e-15 * amax, norm1, a, pattern })
     }
 
@@ -88,11 +102,13 @@ impl Ldlt {
     /// `None` at a zero pivot or a non-finite factor.
     pub fn of(j: &Jacobian) -> Option<Self> {
         let p = &j.pattern;
-        let mut s = p.take(j.a.len());
-        for ((sk, &v), &t) in s.iter_mut().zip(&j.a).zip(&p.transpose) {
-            *sk = 0.5 * (v + j.a[t]);
-        }
-        let mut values = p.take(p.symbolic.len_val());
+        let mut s = p.take_any(j.a.len()); // every slot written
+        s.par_iter_mut().zip(&j.a).zip(&p.transpose).with_min_len(4096).for_each(
+            |((sk, &v), &t)| {
+                *sk = 0.5 * (v + j.a[t]);
+            },
+        );
+        let mut values = p.take_any(p.symbolic.len_val()); // zeroed by the factorisation
         let par = threads();
         let ok = {
             let mut mem = MemBuffer::new(

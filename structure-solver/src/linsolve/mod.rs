@@ -141,6 +141,14 @@ impl FreeSolver {
         self.stats
     }
 
+    /// Drops the kept factor and the current matrix: the next solve factors afresh, as a
+    /// solver made anew would (a run restarted from a checkpoint of this state).
+    pub fn forget_factor(&mut self) {
+        self.kept = None;
+        self.current = None;
+        self.stale = false;
+    }
+
     /// Follows a change of `model`'s topology (its `topology_epoch`): a new free-dof numbering
     /// starts over; the same numbering keeps the pattern, and the next assembly checks the
     /// full fingerprint of the triplet stream before reusing the map.
@@ -202,7 +210,7 @@ impl FreeSolver {
         let (Some(pattern), Some(map)) = (&self.pattern, &self.map) else {
             return Err(FactorError("no matrix pattern".into()));
         };
-        let mut a = pattern.take(pattern.nnz());
+        let mut a = pattern.take_any(pattern.nnz()); // every slot written
         map.scatter_with(|t| ck * k[t].val, &mut a);
         if let Some((cm, m)) = mass {
             for (d, &mi) in m.iter().enumerate() {

@@ -192,10 +192,10 @@ impl Pattern {
         self.row_idx.len()
     }
 
-    /// A zeroed array of `len` values, from the pool if it has one.
-    pub fn take(&self, len: usize) -> Vec<f64> {
+    /// An array of `len` values of no particular content (to be overwritten), from the pool
+    /// if it has one.
+    pub fn take_any(&self, len: usize) -> Vec<f64> {
         let mut v = self.pool.lock().map(|mut p| p.pop()).ok().flatten().unwrap_or_default();
-        v.clear();
         v.resize(len, 0.0);
         v
     }

@@ -135,6 +135,12 @@ impl Implicit {
         self.solver.set_reuse(reuse);
     }
 
+    /// Drops the kept factor, so that the next step starts as a resumed integrator does: call
+    /// it at each checkpoint to make a run restarted from there reproduce the run bit for bit.
+    pub fn forget_factor(&mut self) {
+        self.solver.forget_factor();
+    }
+
     /// Factorisations and GMRES iterations since the integrator was made.
     pub fn solve_stats(&self) -> SolveStats {
         self.solver.stats()
