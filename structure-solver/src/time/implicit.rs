@@ -78,7 +78,8 @@ pub struct Implicit {
     pub scheme: ImplicitScheme,
     pub state: Dynamics,
     pub params: NewtonParams,
-    solver: FreeSolver,
+    /// Boxed: its kept factor and LU fallback make it large.
+    solver: Box<FreeSolver>,
     fi: Vec<f64>,
     r: Vec<f64>,
     du: Vec<f64>,
@@ -116,7 +117,7 @@ impl Implicit {
             scheme,
             state,
             params: NewtonParams::default(),
-            solver: FreeSolver::new(model),
+            solver: Box::new(FreeSolver::new(model)),
             fi: vec![0.0; n],
             r: vec![0.0; n],
             du: vec![0.0; n],
