@@ -20,6 +20,8 @@ use crate::time::{Implicit, ImplicitScheme};
 pub struct BenchReport {
     pub explicit_bt4: ExplicitBench,
     pub implicit_newmark: Option<ImplicitBench>,
+    /// The factor reused as the GMRES preconditioner, on 1 and 2 threads.
+    pub implicit_factor_reuse: crate::bench_implicit::ImplicitReuseBench,
 }
 
 #[derive(Debug, Serialize)]
@@ -513,5 +515,9 @@ pub fn run(quick: bool, elements: usize, threads: &[usize]) -> anyhow::Result<Be
     let explicit =
         if quick { explicit(400, 5, threads)? } else { explicit(elements, 100, threads)? };
     let implicit = if quick { implicit(10, 2)? } else { implicit(100, 3)? };
-    Ok(BenchReport { explicit_bt4: explicit, implicit_newmark: Some(implicit) })
+    Ok(BenchReport {
+        explicit_bt4: explicit,
+        implicit_newmark: Some(implicit),
+        implicit_factor_reuse: crate::bench_implicit::run(quick)?,
+    })
 }

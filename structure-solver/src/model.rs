@@ -50,6 +50,13 @@ pub trait Model: Send {
     /// Consistent tangent (material + geometric) of internal minus external force, as triplets.
     fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>);
 
+    /// A counter the model increases whenever its topology changes at run time (elements or
+    /// constraints added, removed or duplicated): sparse solvers then check the pattern of the
+    /// tangent's triplet stream again. Constant (0) by default.
+    fn topology_epoch(&self) -> u64 {
+        0
+    }
+
     /// `false` when some part has no tangent (explicit-only elements): static and implicit
     /// solvers refuse such a model.
     fn has_tangent(&self) -> bool {

@@ -1,12 +1,12 @@
-//! Static equilibrium of a `Model`: load-stepped Newton-Raphson with a sparse direct solve
-//! (`linsolve`, on the free dofs) and step cutting, displacement control (Batoz & Dhatt 1979)
+//! Static equilibrium of a `Model`: load-stepped Newton-Raphson with a sparse solve on the
+//! free dofs (`linsolve`: GMRES preconditioned with an `LDLᵀ` factor kept across iterations
+//! and steps while it converges fast, refactored otherwise) and step cutting, displacement control (Batoz & Dhatt 1979)
 //! and cylindrical arc length (Crisfield 1981) for paths with limit points in load.
 //! Pseudo-time `t` is the load factor.
 
-use faer::linalg::solvers::Solve;
 use faer::Mat;
 
-use crate::linsolve::{Factor, FreeDofs, FreeSolver};
+use crate::linsolve::{FreeDofs, FreeSolver, SolveStats};
 use crate::model::Model;
 
 /// How far above the tolerance a residual that has stopped falling is accepted as round-off.
@@ -39,6 +39,23 @@ pub struct Converged {
     pub iterations: usize,
     /// Final relative residual.
     pub residual: f64,
+    /// Factorisations of the tangent in the last (sub)step (0: its solves all reused an
+    /// earlier factor).
+    pub factorisations: usize,
+    /// GMRES iterations (preconditioner applications) of the last (sub)step's solves.
+    pub gmres_iterations: usize,
+}
+
+impl Converged {
+    fn new(t: f64, iterations: usize, residual: f64, work: SolveStats) -> Self {
+        Converged {
+            t,
+            iterations,
+            residual,
+            factorisations: work.factorisations,
+            gmres_iterations: work.gmres_iterations,
+        }
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -53,11 +70,29 @@ pub enum StaticsError {
     NoTangent,
 }
 
-/// Factors the free-free block of the model's tangent at `t`.
-fn factor(model: &mut dyn Model, t: f64, solver: &mut FreeSolver) -> Result<Factor, StaticsError> {
+/// Solves the model's tangent at `t` on the free dofs for the full vectors `rhs` (one column
+/// each), the solutions in free numbering.
+fn solve_tangent<const C: usize>(
+    model: &mut dyn Model,
+    t: f64,
+    solver: &mut FreeSolver,
+    rhs: [&[f64]; C],
+) -> Result<[Vec<f64>; C], StaticsError> {
     let mut trip = Vec::new();
     model.tangent(t, &mut trip);
-    solver.factor(&trip, 1.0, None).map_err(|e| StaticsError::Singular(e.0))
+    let singular = |e: crate::linsolve::FactorError| StaticsError::Singular(e.0);
+    solver.assemble(&trip, 1.0, None).map_err(singular)?;
+    let fd = &solver.free;
+    let mut m = Mat::zeros(fd.len(), rhs.len());
+    for (c, v) in rhs.iter().enumerate() {
+        for d in 0..v.len() {
+            if let Some(i) = fd.index(d) {
+                m[(i, c)] = v[d];
+            }
+        }
+    }
+    solver.solve_in_place(m.as_mut()).map_err(singular)?;
+    Ok(std::array::from_fn(|c| (0..m.nrows()).map(|i| m[(i, c)]).collect()))
 }
 
 /// Residual `f_ext - f_int` at `t` (returned: its max norm on the free dofs) and the
@@ -140,6 +175,8 @@ fn newton(
     applied: &mut [f64],
     s: &NewtonSettings,
 ) -> Result<Converged, f64> {
+    solver.sync(model);
+    let work = solver.stats();
     let n = applied.len();
     let saved = applied.to_vec();
     let mut presc = applied.to_vec();
@@ -166,19 +203,14 @@ fn newton(
         let stalled = rn > 0.5 * prev && last <= STALL_FACTOR * s.tol;
         prev = rn;
         if last <= s.tol || stalled {
-            return Ok(Converged { t, iterations: it, residual: last });
+            return Ok(Converged::new(t, it, last, solver.stats().since(&work)));
         }
         if it == s.max_iter {
             break;
         }
-        let lu = match factor(model, t, solver) {
-            Ok(lu) => lu,
-            Err(_) => break,
-        };
-        let mut rhs = solver.free.gather(&r);
-        lu.solve_in_place(rhs.as_mut());
+        let Ok([step]) = solve_tangent(model, t, solver, [&r]) else { break };
         du.fill(0.0);
-        solver.free.scatter(&rhs, &mut du);
+        solver.free.scatter_values(&step, &mut du);
         if du.iter().any(|v| !v.is_finite()) {
             break;
         }
@@ -217,11 +249,12 @@ pub fn displacement_control(
     for &target in targets {
         let mut ok = false;
         let mut last = f64::INFINITY;
+        let work = solver.stats();
         for it in 0..=s.max_iter {
             let (rn, scale) = residual(model, lambda, &fd, &mut r);
             last = rn / scale;
             if last <= s.tol && (uc - target).abs() <= 1e-12 * target.abs().max(1e-30) {
-                let conv = Converged { t: lambda, iterations: it, residual: last };
+                let conv = Converged::new(lambda, it, last, solver.stats().since(&work));
                 model.commit();
                 out.push(conv);
                 on_step(&mut *model, conv);
@@ -232,15 +265,11 @@ pub fn displacement_control(
                 break;
             }
             model.external_force(1.0, &mut fref);
-            let lu = factor(model, lambda, &mut solver)?;
-            let mut a = fd.gather(&r);
-            lu.solve_in_place(a.as_mut());
-            let mut b = fd.gather(&fref);
-            lu.solve_in_place(b.as_mut());
-            let dl = (target - uc - a[(c, 0)]) / b[(c, 0)];
-            let step = Mat::from_fn(fd.len(), 1, |i, _| a[(i, 0)] + dl * b[(i, 0)]);
+            let [a, b] = solve_tangent(model, lambda, &mut solver, [&r, &fref])?;
+            let dl = (target - uc - a[c]) / b[c];
+            let step: Vec<f64> = a.iter().zip(&b).map(|(a, b)| a + dl * b).collect();
             du.fill(0.0);
-            fd.scatter(&step, &mut du);
+            fd.scatter_values(&step, &mut du);
             model.apply_increment(&du);
             lambda += dl;
             uc += du[control];
@@ -338,11 +367,6 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// The entries of a free column.
-fn column(m: &Mat<f64>) -> Vec<f64> {
-    (0..m.nrows()).map(|i| m[(i, 0)]).collect()
-}
-
 /// One arc-length step of length `dl` from the committed state at `lambda`; returns the
 /// converged state and the step's free-dof increment, or the relative residual on failure.
 fn arc_step(
@@ -353,15 +377,14 @@ fn arc_step(
     previous: Option<&[f64]>,
     s: &NewtonSettings,
 ) -> Result<(Converged, Vec<f64>), f64> {
+    solver.sync(model);
+    let work = solver.stats();
     let n = model.n_dof();
     let fd = solver.free.clone();
     let (mut r, mut fref, mut du) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     // predictor
     model.external_force(1.0, &mut fref);
-    let lu = factor(model, lambda, solver).map_err(|_| f64::INFINITY)?;
-    let mut ut = fd.gather(&fref);
-    lu.solve_in_place(ut.as_mut());
-    let ut = column(&ut);
+    let [ut] = solve_tangent(model, lambda, solver, [&fref]).map_err(|_| f64::INFINITY)?;
     let norm = dot(&ut, &ut).sqrt();
     if !(norm.is_finite() && norm > 0.0) {
         return Err(f64::INFINITY);
@@ -372,7 +395,7 @@ fn arc_step(
     };
     let mut dlam = sign * dl / norm;
     let mut inc: Vec<f64> = ut.iter().map(|v| dlam * v).collect();
-    fd.scatter(&Mat::from_fn(inc.len(), 1, |i, _| inc[i]), &mut du);
+    fd.scatter_values(&inc, &mut du);
     model.apply_increment(&du);
     let mut last = f64::INFINITY;
     for it in 0..=s.max_iter {
@@ -382,18 +405,16 @@ fn arc_step(
             break;
         }
         if last <= s.tol {
-            return Ok((Converged { t: lambda + dlam, iterations: it, residual: last }, inc));
+            let work = solver.stats().since(&work);
+            return Ok((Converged::new(lambda + dlam, it, last, work), inc));
         }
         if it == s.max_iter {
             break;
         }
         model.external_force(1.0, &mut fref);
-        let Ok(lu) = factor(model, lambda + dlam, solver) else { break };
-        let mut a = fd.gather(&r);
-        lu.solve_in_place(a.as_mut());
-        let mut b = fd.gather(&fref);
-        lu.solve_in_place(b.as_mut());
-        let (ur, ut) = (column(&a), column(&b));
+        let Ok([ur, ut]) = solve_tangent(model, lambda + dlam, solver, [&r, &fref]) else {
+            break;
+        };
         // |inc + ur + δλ ut|² = dl²
         let w: Vec<f64> = inc.iter().zip(&ur).map(|(x, y)| x + y).collect();
         let (qa, qb, qc) = (dot(&ut, &ut), 2.0 * dot(&ut, &w), dot(&w, &w) - dl * dl);
@@ -407,8 +428,8 @@ fn arc_step(
         let dlm = if angle(roots[0]) >= angle(roots[1]) { roots[0] } else { roots[1] };
         let step: Vec<f64> = w.iter().zip(&ut).map(|(w, t)| w + dlm * t).collect();
         du.fill(0.0);
-        let delta = Mat::from_fn(step.len(), 1, |i, _| step[i] - inc[i]);
-        fd.scatter(&delta, &mut du);
+        let delta: Vec<f64> = step.iter().zip(&inc).map(|(s, i)| s - i).collect();
+        fd.scatter_values(&delta, &mut du);
         if du.iter().any(|v| !v.is_finite()) {
             break;
         }

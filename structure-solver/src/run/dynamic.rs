@@ -84,6 +84,9 @@ impl Dynamic<'_> {
                     .with_context(|| format!("step {n} (t = {:e})", im.state.t + step))?;
                 self.finite(model, &mut disp, (&im.state.v, &im.state.a, None), im.state.t)?;
                 self.after_step(model, &im.state, step)?;
+                if self.checkpoint_every > 0 && self.reached.steps % self.checkpoint_every == 0 {
+                    im.forget_factor(); // a restart from this checkpoint starts afresh too
+                }
             }
         }
         Ok(())

@@ -1,4 +1,6 @@
-//! Implicit steps with Newton and a sparse direct solve (`linsolve`: faer LU on the free dofs):
+//! Implicit steps with Newton and a sparse solve on the free dofs (`linsolve`: GMRES
+//! preconditioned with an `LDLᵀ` factor kept across Newton iterations and steps while it
+//! converges within `REUSE_ITERATIONS`, refactored otherwise):
 //!
 //! - **Newmark, average acceleration** (β = 1/4, γ = 1/2; Newmark 1959): unknown `Δu`,
 //!   `a^{n+1} = 4/Δt² (Δu - Δt v^n) - a^n`, `v^{n+1} = v^n + Δt/2 (a^n + a^{n+1})`, residual
@@ -16,11 +18,10 @@
 //! here (central differences integrate them). Rigid slaves follow their masters
 //! (`Model::dependent_motion`).
 
-use faer::linalg::solvers::Solve;
 use faer::sparse::Triplet;
 
 use super::{out_of_balance, prescribed_increment, Dynamics};
-use crate::linsolve::FreeSolver;
+use crate::linsolve::{FreeSolver, SolveStats};
 use crate::model::Model;
 
 /// Which implicit rule.
@@ -50,11 +51,15 @@ impl Default for NewtonParams {
     }
 }
 
-/// Iterations and final residual of a converged step.
+/// Iterations, final residual and linear-solver work of a converged step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepInfo {
     pub iterations: usize,
     pub residual: f64,
+    /// Factorisations of the Jacobian in this step (0: all solves reused an earlier factor).
+    pub factorisations: usize,
+    /// GMRES iterations (preconditioner applications) of this step's solves.
+    pub gmres_iterations: usize,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -73,7 +78,8 @@ pub struct Implicit {
     pub scheme: ImplicitScheme,
     pub state: Dynamics,
     pub params: NewtonParams,
-    solver: FreeSolver,
+    /// Boxed: its kept factor and LU fallback make it large.
+    solver: Box<FreeSolver>,
     fi: Vec<f64>,
     r: Vec<f64>,
     du: Vec<f64>,
@@ -111,7 +117,7 @@ impl Implicit {
             scheme,
             state,
             params: NewtonParams::default(),
-            solver: FreeSolver::new(model),
+            solver: Box::new(FreeSolver::new(model)),
             fi: vec![0.0; n],
             r: vec![0.0; n],
             du: vec![0.0; n],
@@ -122,6 +128,23 @@ impl Implicit {
             triplets: Vec::new(),
             mass_triplets: Vec::new(),
         }
+    }
+
+    /// `false`: factor the Jacobian at every Newton iteration instead of reusing the last
+    /// factor as the GMRES preconditioner (the reference the reuse is checked against).
+    pub fn set_factor_reuse(&mut self, reuse: bool) {
+        self.solver.set_reuse(reuse);
+    }
+
+    /// Drops the kept factor, so that the next step starts as a resumed integrator does: call
+    /// it at each checkpoint to make a run restarted from there reproduce the run bit for bit.
+    pub fn forget_factor(&mut self) {
+        self.solver.forget_factor();
+    }
+
+    /// Factorisations and GMRES iterations since the integrator was made.
+    pub fn solve_stats(&self) -> SolveStats {
+        self.solver.stats()
     }
 
     /// Mass and stiffness factors of the Jacobian, and the stage at which forces are evaluated
@@ -156,6 +179,8 @@ impl Implicit {
         if !model.has_tangent() {
             return Err(ImplicitError::NoTangent);
         }
+        self.solver.sync(model);
+        let work = self.solver.stats();
         let n = model.n_dof();
         let t0 = self.state.t;
         let (cm, ck, stage) = self.coefficients(dt);
@@ -197,7 +222,13 @@ impl Implicit {
             last = (rn, reference);
             if rn <= self.params.tol * reference || rn <= self.params.abs_tol || stalled {
                 self.finish(model, dt, stage);
-                return Ok(StepInfo { iterations: it, residual: rn / reference.max(1e-300) });
+                let work = self.solver.stats().since(&work);
+                return Ok(StepInfo {
+                    iterations: it,
+                    residual: rn / reference.max(1e-300),
+                    factorisations: work.factorisations,
+                    gmres_iterations: work.gmres_iterations,
+                });
             }
             if it == self.params.max_iter {
                 break;
@@ -210,11 +241,15 @@ impl Implicit {
             self.triplets.extend(
                 self.mass_triplets.iter().map(|e| Triplet::new(e.row, e.col, scale * e.val)),
             );
-            let lu = self
+            let mut sol = self.solver.free.gather(&self.r);
+            let solved = self
                 .solver
-                .factor(&self.triplets, ck, Some((cm, &mass)))
-                .map_err(|e| ImplicitError::Singular(e.0))?;
-            let sol = lu.solve(&self.solver.free.gather(&self.r));
+                .assemble(&self.triplets, ck, Some((cm, &mass)))
+                .and_then(|()| self.solver.solve_in_place(sol.as_mut()));
+            if let Err(e) = solved {
+                model.revert();
+                return Err(ImplicitError::Singular(e.0));
+            }
             for (i, &c) in constrained.iter().enumerate() {
                 let d = if c { 0.0 } else { sol[(self.solver.free.index(i).expect("free"), 0)] };
                 self.du[i] += d;
