@@ -6,7 +6,7 @@
 //! coordinates, original ids, dual volumes and dual areas, the gradient operator's inverse
 //! matrix, the conserved state and material id and the five workspace arrays; per edge its two node numbers and
 //! its area normal, at [`EDGES_PER_NODE`] edges per node; per cell its [`Cell`]. `fluid-solver
-//! bench` measured 805 B/node on a tet box, cells included; the test below holds this estimate
+//! bench` measured 806 B/node on a tet box, cells included; the test below holds this estimate
 //! to the arrays of a built mesh.
 
 use crate::mesh::Cell;

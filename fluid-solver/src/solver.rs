@@ -138,15 +138,8 @@ impl<'a> FluidRun<'a> {
             None => (initial, 0, 0.0),
         };
         if state.material != semi.material() {
-            if let Some((i, &m)) =
-                state.material.iter().enumerate().find(|(_, &m)| m as usize >= semi.eos.len())
-            {
-                anyhow::bail!(
-                    "the checkpoint gives node {i} material {m}, but the case has {} fluids",
-                    semi.eos.len()
-                );
-            }
-            semi.set_materials(state.material.clone())?;
+            semi.set_materials(state.material.clone())
+                .context("the checkpoint's node materials do not fit the case")?;
         }
         let policy = match mode {
             Mode::Alone => Policy::alone(opts.force, opts.restart.as_deref(), &opts.out),

@@ -158,7 +158,7 @@ fn the_first_residual_at_the_interface_is_the_two_phase_flux() {
 fn wavy_water(x: [f64; 3]) -> [f64; 5] {
     let s = (3.0 * x[0] + 2.0 * x[1] - x[2]).sin();
     let c = (2.0 * x[0] - x[1] + 4.0 * x[2]).cos();
-    [1000.0 * (1.0 + 0.01 * s), 2.0 * c, -1.0 * s, 0.5 * s * c, 1e5 * (1.0 + 0.5 * c)]
+    [1000.0 * (1.0 + 0.01 * s), 2.0 * c, -s, 0.5 * s * c, 1e5 * (1.0 + 0.5 * c)]
 }
 
 fn wavy_air(x: [f64; 3]) -> [f64; 5] {
