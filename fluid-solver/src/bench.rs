@@ -80,7 +80,7 @@ pub struct TwoMaterial {
 }
 
 /// Median of a non-empty list.
-fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
     if n % 2 == 1 {

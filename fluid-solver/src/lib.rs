@@ -12,6 +12,7 @@
 
 pub mod bc;
 pub mod bench;
+pub mod bench_embedded;
 pub mod check;
 pub mod couple;
 pub mod embedded;

@@ -2,7 +2,7 @@
 //! checks a case without running it (`check`), or measures its speed (`bench`).
 
 use clap::{Parser, Subcommand};
-use fluid_solver::{bench, check, couple, solver};
+use fluid_solver::{bench, bench_embedded, check, couple, solver};
 use interface_protocol::cli::{CheckArgs, RunArgs};
 use interface_protocol::io::outdir;
 use std::path::PathBuf;
@@ -51,6 +51,9 @@ enum Command {
         /// (fluid-solver/bench/run-c-reference.sh).
         #[arg(long, value_name = "FILE")]
         dump_edges: Option<PathBuf>,
+        /// Also measure the embedded boundary (tracking, wall fluxes, memory): key `embedded`.
+        #[arg(long)]
+        embedded: bool,
     },
 }
 
@@ -66,9 +69,15 @@ fn main() -> ExitCode {
             }
             Ok(())
         }),
-        Command::Bench { nodes, steps, threads, dump_edges } => {
-            bench::run(nodes, steps, &threads, dump_edges.as_deref()).map(|report| {
-                println!("{}", serde_json::to_string_pretty(&report).expect("JSON"));
+        Command::Bench { nodes, steps, threads, dump_edges, embedded } => {
+            bench::run(nodes, steps, &threads, dump_edges.as_deref()).and_then(|report| {
+                let mut json = serde_json::to_value(&report)?;
+                if embedded {
+                    json["embedded"] =
+                        serde_json::to_value(bench_embedded::run(nodes, steps, &report)?)?;
+                }
+                println!("{}", serde_json::to_string_pretty(&json)?);
+                Ok(())
             })
         }
     };

@@ -168,6 +168,15 @@ impl Bvh {
         self.tri_lo.is_empty()
     }
 
+    /// Memory in bytes of the tree and the triangle boxes.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.nodes[..])
+            + size_of_val(&self.order[..])
+            + size_of_val(&self.tri_lo[..])
+            + size_of_val(&self.tri_hi[..])
+    }
+
     /// The swept, padded box of triangle `t`.
     #[inline]
     pub fn triangle_box(&self, t: usize) -> ([f64; 3], [f64; 3]) {

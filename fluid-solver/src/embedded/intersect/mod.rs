@@ -24,6 +24,12 @@ use crate::mesh::Mesh;
 /// occluded.
 pub const OCCLUSION: f64 = 1e-8;
 
+/// Whether an interpolated phi rules a hit out: negative, or NaN (never `>= 0`).
+#[inline]
+fn below_zero_or_nan(phi: f64) -> bool {
+    phi.is_nan() || phi < 0.0
+}
+
 /// The cut edges of a mesh at one time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Intersections {
@@ -146,7 +152,7 @@ impl SurfaceAt<'_> {
         self.bvh.for_each_overlap(&lo, &hi, |t| {
             let [a, b, c] = self.corners(t);
             if let Some(h) = segment_triangle(p, q, a, b, c) {
-                if crack_aware && self.phi(t, h.bary) < 0.0 {
+                if crack_aware && below_zero_or_nan(self.phi(t, h.bary)) {
                     return;
                 }
                 if best.is_none_or(|(al, bt, _)| (h.alpha, t) < (al, bt)) {
@@ -167,7 +173,7 @@ impl SurfaceAt<'_> {
         self.bvh.for_each_overlap(&lo, &hi, |t| {
             let [a, b, c] = self.corners(t);
             let cp = closest_point(p, a, b, c);
-            if crack_aware && self.phi(t, cp.bary) < 0.0 {
+            if crack_aware && below_zero_or_nan(self.phi(t, cp.bary)) {
                 return;
             }
             if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
