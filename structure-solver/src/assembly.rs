@@ -26,7 +26,7 @@ use faer::sparse::Triplet;
 
 use crate::elements::bt4::{Bt4, Bt4Settings};
 pub use crate::elements::RotaryInertia;
-use crate::elements::{BeamSection, Element, ElementKind, ShellSection, ShellYield};
+use crate::elements::{BeamSection, BeamYield, Element, ElementKind, ShellSection, ShellYield};
 use crate::material::{Elastic, Material, ThicknessRule, J2};
 use crate::mesh::{CellKind, Mesh};
 use crate::model::Model;
@@ -79,6 +79,8 @@ pub enum Part {
     Bt4(ShellSection, Option<ShellYield>),
     /// A beam whose local `y` axis is `up` projected normal to it.
     Beam(BeamSection, [f64; 3]),
+    /// A beam of a J2 material by fibres (`elements::beam::FibreBeam`), `up` as for `Beam`.
+    BeamJ2(BeamSection, [f64; 3], BeamYield),
     /// A solid of an elastic or J2 material.
     Solid(Material),
 }
@@ -319,6 +321,9 @@ impl FeModel {
                 (CellKind::Line2, Part::Beam(s, up)) => {
                     Element::beam2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s)
                 }
+                (CellKind::Line2, Part::BeamJ2(s, up, y)) => {
+                    Element::beam2_j2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s, y)
+                }
                 (CellKind::Tet4, Part::Solid(mat)) => {
                     Element::tet4([nd[0], nd[1], nd[2], nd[3]], &[p[0], p[1], p[2], p[3]], mat)
                 }
@@ -326,7 +331,7 @@ impl FeModel {
                     let part = match p {
                         Part::Shell(_) | Part::ShellJ2(..) => "a shell section",
                         Part::Bt4(..) => "a BT4 shell (quadrilaterals only)",
-                        Part::Beam(..) => "a beam section",
+                        Part::Beam(..) | Part::BeamJ2(..) => "a beam section",
                         Part::Solid(_) => "a solid material",
                     };
                     return Err(AssemblyError::Mismatch { cell: ci, kind, part });
