@@ -168,30 +168,18 @@ impl Blt3 {
         }
     }
 
-    /// The element estimate of the critical step: the smaller of the membrane bound `L / c`,
-    /// `L = 2A / (√2 · longest side)` (Hallquist's `2A / longest side`, reduced by √2 since the
-    /// lumped CST's highest mode reaches `√2 c / L`), `c` the plate wave speed, and the
-    /// rotational bound `2/ω_r`, `ω_r² = (2 κ G + E h²/(3A)) · 4 / (ρ (h² + a))` of a node's
-    /// rotary inertia `m (h² + a)/12` against the assumed shear and the bending stiffness
-    /// (`a = A` when scaled, else 0); `tests/blt3.rs` checks it against the element's
-    /// eigenvalues.
+    /// The element estimate of the critical step, `2 / ω_max` with `ω_max²` bounded by the
+    /// largest Gershgorin row sum of the element's `M^-1/2 K M^-1/2` (its elastic stiffness,
+    /// `A Bᵀ D B` with `D` the membrane `h C`, bending `h³/12 C` and shear `κ G h` moduli, in the
+    /// corotated frame, where the nodal masses are isotropic): a true upper bound of the
+    /// element's eigenvalues, which bound the assembled ones (Irons 1970), for any shape and
+    /// rotary inertia; `tests/blt3_dynamics.rs` measures how close it is.
     pub fn stable_dt(&self, x: &[[f64; 3]]) -> f64 {
-        let el = self.material.elastic;
-        let c = el.plate_wave_speed();
         let mut dt = f64::INFINITY;
         for (conn, &h) in self.conn.iter().zip(&self.thickness) {
-            let xe = conn.map(|n| x[n as usize]);
-            let a = frame(&xe).area;
-            let side = |i: usize, j: usize| {
-                let d: [f64; 3] = std::array::from_fn(|k| xe[i][k] - xe[j][k]);
-                dot(d, d).sqrt()
-            };
-            let l =
-                2.0 * a / (std::f64::consts::SQRT_2 * side(0, 1).max(side(1, 2)).max(side(2, 0)));
-            let a_rot = self.settings.rotary.added_area(a);
-            let w2 = (2.0 * SHEAR_FACTOR * el.shear_modulus() + el.e * h * h / (3.0 * a)) * 4.0
-                / (el.rho * (h * h + a_rot));
-            dt = dt.min(l / c).min(2.0 / w2.sqrt());
+            let f = frame(&conn.map(|n| x[n as usize]));
+            let w2 = max_frequency_squared(&self.material, &self.settings, &f, h);
+            dt = dt.min(2.0 / w2.sqrt());
         }
         dt
     }
@@ -229,6 +217,41 @@ impl Blt3 {
             }
         }
     }
+}
+
+/// Gershgorin bound of the largest eigenvalue of `M^-1/2 K M^-1/2` of one element of
+/// thickness `h` in frame `f` (elastic moduli; `stable_dt`).
+fn max_frequency_squared(mat: &J2, set: &Blt3Settings, f: &Frame, h: f64) -> f64 {
+    let el = mat.elastic;
+    let r = rows(f);
+    let c = el.tangent_plane_stress();
+    let kgh = SHEAR_FACTOR * el.shear_modulus() * h;
+    let mut k = [[0.0; N_DOF]; N_DOF];
+    let mut add = |a: &[f64; N_DOF], b: &[f64; N_DOF], d: f64| {
+        if d != 0.0 {
+            for (ki, ai) in k.iter_mut().zip(a) {
+                for (kij, bj) in ki.iter_mut().zip(b) {
+                    *kij += f.area * d * ai * bj;
+                }
+            }
+        }
+    };
+    for (rows, scale) in [(&r.membrane, h), (&r.curvature, h * h * h / 12.0)] {
+        for i in 0..3 {
+            for j in 0..3 {
+                add(&rows[i], &rows[j], scale * c[i][j]);
+            }
+        }
+    }
+    add(&r.shear[0], &r.shear[0], kgh);
+    add(&r.shear[1], &r.shear[1], kgh);
+    add(&r.shear[2], &r.shear[2], kgh * r.linear_shear_factor);
+    let m = el.rho * h * f.area / 3.0;
+    let i = set.rotary.of_node(m, h, f.area);
+    let mass = |d: usize| if d % 6 < 3 { m } else { i };
+    (0..N_DOF)
+        .map(|a| (0..N_DOF).map(|b| k[a][b].abs() / (mass(a) * mass(b)).sqrt()).sum::<f64>())
+        .fold(0.0, f64::max)
 }
 
 /// One element's step geometry.
