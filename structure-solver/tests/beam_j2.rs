@@ -146,3 +146,48 @@ fn cantilever_collapses_at_the_plastic_moment_and_unloads_elastically() {
     assert!(excess[1] < 0.6 * excess[0], "collapse load converges with the mesh: {excess:?}");
     assert!(excess[1] < 0.01, "40 beams: {:.2}% above the rule's limit", 100.0 * excess[1]);
 }
+
+/// A case whose beam material has `sigma_y` builds J2 beams (8 fibres through the depth when
+/// the part gives no points) on a rectangle; a general section with `sigma_y` is refused,
+/// naming the part's section.
+#[test]
+fn cases_with_a_yield_stress_build_j2_beams_on_rectangles_only() {
+    use interface_protocol::case::Case;
+    use structure_solver::build::build;
+    use structure_solver::elements::RotaryInertia;
+    let case = |section: &str| {
+        let text = format!(
+            r#"[structure]
+mesh = {{ generator = "line", from = [0.0, 0.0, 0.0], to = [1.0, 0.0, 0.0], n = 4 }}
+integrator = "static"
+steps = 1
+[structure.materials.steel]
+e = 200e9
+nu = 0.3
+rho = 7800.0
+sigma_y = 250e6
+[[structure.parts]]
+element = "beam"
+section = {section}
+up = [0.0, 1.0, 0.0]
+[[structure.bc]]
+set = "start"
+fixed = ["ux", "uy", "uz", "rx", "ry", "rz"]
+"#
+        );
+        Case::parse(&text, std::path::Path::new("beam.toml"), &[]).unwrap()
+    };
+    let s = build(&case("{ rectangle = [0.01, 0.02] }"), RotaryInertia::Physical).unwrap();
+    let els = s.model.elements();
+    assert_eq!(els.len(), 4);
+    // 3 stations x 8 x 8 fibres x (εp, α)
+    assert!(els.iter().all(|e| e.n_state() == 3 * 8 * 8 * 2));
+    let err = build(
+        &case("{ area = 2e-4, iy = 6.7e-9, iz = 1.7e-9, j = 4.6e-9 }"),
+        RotaryInertia::Physical,
+    )
+    .err()
+    .expect("a general section with sigma_y");
+    let msg = format!("{err:#}");
+    assert!(msg.contains("structure.parts[0].section") && msg.contains("rectangle"), "{msg}");
+}
