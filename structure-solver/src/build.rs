@@ -12,7 +12,7 @@ use interface_protocol::case::{
 
 use crate::assembly::{AssemblyError, Curve, FeModel, Part, RotaryInertia};
 use crate::case_mesh::build_mesh;
-use crate::elements::{BeamSection, ShellSection, ShellYield};
+use crate::elements::{BeamSection, BeamYield, ShellSection, ShellYield};
 use crate::material::{Elastic, Material, J2};
 use crate::mesh::{validate, CellKind, Mesh};
 use crate::model::Model;
@@ -210,15 +210,27 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                     None => Part::Shell(section),
                 },
                 (ElementType::Beam, CellKind::Line2) => {
-                    if m.sigma_y.is_some() {
-                        return Err(field_error(
-                            case,
-                            &f("material"),
-                            "beams are elastic; give a material without sigma_y",
-                        ));
-                    }
                     let sec = p.section.as_ref().expect("validated: beams have a section");
-                    Part::Beam(beam_section(m, sec), p.up.expect("validated: beams have up"))
+                    let up = p.up.expect("validated: beams have up");
+                    match m.sigma_y {
+                        None => Part::Beam(beam_section(m, sec), up),
+                        // J2 beams integrate fibres over the rectangle
+                        Some(_) if sec.rectangle.is_none() => {
+                            return Err(field_error(
+                                case,
+                                &f("section"),
+                                "J2 beams (a material with sigma_y) need `rectangle = [b, h]`",
+                            ))
+                        }
+                        Some(sigma_y) => {
+                            let y = BeamYield {
+                                sigma_y,
+                                hardening: m.hardening,
+                                points: p.points.unwrap_or(8),
+                            };
+                            Part::BeamJ2(beam_section(m, sec), up, y)
+                        }
+                    }
                 }
                 (ElementType::Tet4, CellKind::Tet4) => {
                     let elastic = Elastic { e: m.e, nu: m.nu, rho: m.rho };

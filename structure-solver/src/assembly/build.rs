@@ -60,6 +60,9 @@ impl FeModel {
                 (CellKind::Line2, Part::Beam(s, up)) => {
                     Element::beam2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s)
                 }
+                (CellKind::Line2, Part::BeamJ2(s, up, y)) => {
+                    Element::beam2_j2([nd[0], nd[1]], &[p[0], p[1]], Vector3::from(up), &s, y)
+                }
                 (CellKind::Tet4, Part::Solid(mat)) => {
                     Element::tet4([nd[0], nd[1], nd[2], nd[3]], &[p[0], p[1], p[2], p[3]], mat)
                 }
@@ -67,7 +70,7 @@ impl FeModel {
                     let part = match p {
                         Part::Shell(_) | Part::ShellJ2(..) => "a shell section",
                         Part::Bt4(..) => "a BT4 shell (quadrilaterals only)",
-                        Part::Beam(..) => "a beam section",
+                        Part::Beam(..) | Part::BeamJ2(..) => "a beam section",
                         Part::Solid(_) => "a solid material",
                     };
                     return Err(AssemblyError::Mismatch { cell: ci, kind, part });

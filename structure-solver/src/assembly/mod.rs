@@ -39,7 +39,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::elements::bt4::Bt4;
 pub use crate::elements::RotaryInertia;
-use crate::elements::{BeamSection, Element, ShellSection, ShellYield};
+use crate::elements::{BeamSection, BeamYield, Element, ShellSection, ShellYield};
 use crate::material::Material;
 use crate::mesh::CellKind;
 use crate::rigid::RigidBody;
@@ -59,6 +59,8 @@ pub enum Part {
     Bt4(ShellSection, Option<ShellYield>),
     /// A beam whose local `y` axis is `up` projected normal to it.
     Beam(BeamSection, [f64; 3]),
+    /// A beam of a J2 material by fibres (`elements::beam::FibreBeam`), `up` as for `Beam`.
+    BeamJ2(BeamSection, [f64; 3], BeamYield),
     /// A solid of an elastic or J2 material.
     Solid(Material),
 }

@@ -1,5 +1,5 @@
 //! The element container: corotated shells (elastic, or J2 through the thickness: `layered`)
-//! and beams, total-Lagrangian tets, each with its internal force from a flat per-element
+//! and beams (elastic, or J2 by fibres: `beam::FibreBeam`), total-Lagrangian tets, each with its internal force from a flat per-element
 //! material state, a consistent tangent (corotated elements: `Bᵀ K_l B` plus the geometric
 //! stiffness of `corotation::Reference::tangent`, with the algorithmic tangent of J2 sections;
 //! tets: central differences of the force, translations perturbed additively, rotations by
@@ -9,10 +9,11 @@
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
+use super::beam::FibreBeam;
 use super::corotation::{FrameRule, Reference};
 use super::layered::{LayeredJ2, Layers};
 use super::rotation::exp;
-use super::section::{BeamSection, ShellSection, ShellYield};
+use super::section::{BeamSection, BeamYield, ShellSection, ShellYield};
 use super::tet4::Tet4;
 use super::{beam, dkt, mitc4};
 use crate::material::j2::J2State3d;
@@ -42,6 +43,11 @@ enum Body {
     Layered {
         reference: Reference,
         shell: Box<LayeredJ2>,
+    },
+    /// Corotated beam of a J2 material integrated over fibres.
+    Fibred {
+        reference: Reference,
+        beam: Box<FibreBeam>,
     },
     Tet(Tet4),
 }
@@ -145,18 +151,8 @@ impl Element {
         up: Vector3<f64>,
         sec: &BeamSection,
     ) -> Self {
-        let chord = x0[1] - x0[0];
-        let l = chord.norm();
-        let e1 = chord / l;
-        let q0 = (up - up.dot(&e1) * e1).normalize();
-        let reference = Reference::new(FrameRule::Beam { q0: [q0.x, q0.y, q0.z] }, x0);
+        let (reference, l, mass) = Self::beam_frame(x0, up, sec);
         let k = beam::stiffness(l, sec);
-        let m = sec.rho * sec.area * l / 2.0;
-        // section inertia (torsion, y, z) rotated to global, diagonal kept
-        let local = Matrix3::from_diagonal(&Vector3::new(sec.iy + sec.iz, sec.iy, sec.iz))
-            * (sec.rho * l / 2.0);
-        let g = reference.e0 * local * reference.e0.transpose();
-        let mass = (0..2).flat_map(|_| [m, m, m, g[(0, 0)], g[(1, 1)], g[(2, 2)]]).collect();
         Element {
             kind: ElementKind::Beam2,
             nodes: nodes.to_vec(),
@@ -164,6 +160,44 @@ impl Element {
             mass,
             measure: l,
         }
+    }
+
+    /// A 2-node beam of a J2 material by fibres (`beam::FibreBeam`); `up` as for `beam2`.
+    pub fn beam2_j2(
+        nodes: [usize; 2],
+        x0: &[Vector3<f64>; 2],
+        up: Vector3<f64>,
+        sec: &BeamSection,
+        yield_: BeamYield,
+    ) -> Self {
+        let (reference, l, mass) = Self::beam_frame(x0, up, sec);
+        Element {
+            kind: ElementKind::Beam2,
+            nodes: nodes.to_vec(),
+            body: Body::Fibred { reference, beam: Box::new(FibreBeam::new(l, *sec, yield_)) },
+            mass,
+            measure: l,
+        }
+    }
+
+    /// The corotated reference, length and lumped mass of a beam.
+    fn beam_frame(
+        x0: &[Vector3<f64>; 2],
+        up: Vector3<f64>,
+        sec: &BeamSection,
+    ) -> (Reference, f64, Vec<f64>) {
+        let chord = x0[1] - x0[0];
+        let l = chord.norm();
+        let e1 = chord / l;
+        let q0 = (up - up.dot(&e1) * e1).normalize();
+        let reference = Reference::new(FrameRule::Beam { q0: [q0.x, q0.y, q0.z] }, x0);
+        let m = sec.rho * sec.area * l / 2.0;
+        // section inertia (torsion, y, z) rotated to global, diagonal kept
+        let local = Matrix3::from_diagonal(&Vector3::new(sec.iy + sec.iz, sec.iy, sec.iz))
+            * (sec.rho * l / 2.0);
+        let g = reference.e0 * local * reference.e0.transpose();
+        let mass = (0..2).flat_map(|_| [m, m, m, g[(0, 0)], g[(1, 1)], g[(2, 2)]]).collect();
+        (reference, l, mass)
     }
 
     /// A 4-node tetrahedron.
@@ -191,6 +225,7 @@ impl Element {
         match &self.body {
             Body::Corotated { .. } => 0,
             Body::Layered { shell, .. } => shell.n_state(),
+            Body::Fibred { beam, .. } => beam.n_state(),
             Body::Tet(_) => TET_STATE,
         }
     }
@@ -224,6 +259,10 @@ impl Element {
                 let local = |d: &[f64], fl: &mut [f64]| shell.force(d, old, new, fl, None);
                 reference.force(x, r, &mut d[..nd], local, f);
             }
+            Body::Fibred { reference, beam } => {
+                let local = |d: &[f64], fl: &mut [f64]| beam.force(d, old, new, fl, None);
+                reference.force(x, r, &mut d[..nd], local, f);
+            }
             Body::Tet(t) => {
                 let xs = [x[0], x[1], x[2], x[3]];
                 let state = J2State3d { eps_p: std::array::from_fn(|i| old[i]), alpha: old[6] };
@@ -241,7 +280,9 @@ impl Element {
     /// Local deformational displacements `d` of a corotated element (None for tets).
     pub fn deformation(&self, x: &[Vector3<f64>], r: &[Matrix3<f64>]) -> Option<Vec<f64>> {
         match &self.body {
-            Body::Corotated { reference, .. } | Body::Layered { reference, .. } => {
+            Body::Corotated { reference, .. }
+            | Body::Layered { reference, .. }
+            | Body::Fibred { reference, .. } => {
                 let mut d = vec![0.0; 6 * x.len()];
                 reference.deformation(x, r, &mut d, None);
                 Some(d)
@@ -256,7 +297,7 @@ impl Element {
     /// (elastic, `Layers::von_mises`), in-plane stresses only; beams, the largest axial plus
     /// bending stress `|N|/A + |M_y| c_z/I_y + |M_z| c_y/I_z` at the two ends, `c` the corner
     /// distances of the rectangle with the section's `A`, `I_y`, `I_z` (exact for rectangular
-    /// sections; torsion left out); tets, of the Cauchy stress (`Tet4::von_mises`).
+    /// sections; torsion left out), J2 beams the largest `|σ|` of their fibres; tets, of the Cauchy stress (`Tet4::von_mises`).
     pub fn von_mises(&self, x: &[Vector3<f64>], r: &[Matrix3<f64>], state: &[f64]) -> f64 {
         let local = || self.deformation(x, r).unwrap_or_default();
         match &self.body {
@@ -283,6 +324,7 @@ impl Element {
                     .fold(0.0, f64::max)
             }
             Body::Layered { shell, .. } => shell.von_mises(&local(), state),
+            Body::Fibred { beam, .. } => beam.von_mises(&local(), state),
             Body::Tet(t) => {
                 let xs = [x[0], x[1], x[2], x[3]];
                 let st = J2State3d { eps_p: std::array::from_fn(|i| state[i]), alpha: state[6] };
@@ -321,6 +363,16 @@ impl Element {
                 let mut kl = DMatrix::zeros(size, size);
                 let mut trial = vec![0.0; state.len()];
                 shell.force(&d, state, &mut trial, &mut fl, Some(&mut kl));
+                (reference, fl, std::borrow::Cow::Owned(kl), d, b, fr)
+            }
+            Body::Fibred { reference, beam } => {
+                let mut d = vec![0.0; size];
+                let mut b = DMatrix::zeros(size, size);
+                let fr = reference.deformation(x, r, &mut d, Some(&mut b));
+                let mut fl = vec![0.0; size];
+                let mut kl = DMatrix::zeros(size, size);
+                let mut trial = vec![0.0; state.len()];
+                beam.force(&d, state, &mut trial, &mut fl, Some(&mut kl));
                 (reference, fl, std::borrow::Cow::Owned(kl), d, b, fr)
             }
         };
