@@ -7,7 +7,6 @@ use crate::mesh::boxmesh::{BoxCells, BoxSpec};
 use crate::mesh::geometry::{add, cross, norm, scale, sub};
 use crate::mesh::perturb;
 use interface_protocol::messages::SurfaceElement;
-use std::collections::HashMap;
 
 fn surface(x: Vec<[f64; 3]>, elements: &[[u32; 4]]) -> Surface {
     let e: Vec<SurfaceElement> = elements
@@ -236,62 +235,11 @@ fn rotate(a: [f64; 3], angle: f64, v: [f64; 3]) -> [f64; 3] {
     add(add(scale(v, c), scale(kv, s)), scale(k, kdv * (1.0 - c)))
 }
 
-/// An icosphere (icosahedron split `levels` times) of radius `r`, outward winding.
+/// An icosphere of radius `r` about the origin with `levels` refinements, as triangles.
 fn icosphere(levels: usize, r: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut x: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut tris: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut mid = HashMap::new();
-        let mut next = Vec::new();
-        for [a, b, c] in tris {
-            let mut m = |p: u32, q: u32| {
-                *mid.entry((p.min(q), p.max(q))).or_insert_with(|| {
-                    x.push(scale(add(x[p as usize], x[q as usize]), 0.5));
-                    (x.len() - 1) as u32
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        tris = next;
-    }
-    let x = x.into_iter().map(|p| scale(p, r / norm(p))).collect();
-    (x, tris)
+    let s = crate::embedded::generate::sphere([0.0; 3], r, levels as u32);
+    let tris = s.elements.iter().map(|e| [e.nodes[0], e.nodes[1], e.nodes[2]]).collect();
+    (s.x, tris)
 }
 
 /// A cube of side `a` centred at the origin as 6 outward quads.
