@@ -48,9 +48,12 @@ pub fn prescribed(case: &Case, mesh: &Mesh, t0: f64) -> anyhow::Result<Option<Pr
     };
     let s = surface_mesh(case, e)?;
     let motion = e.motion.clone().map(RigidMotion::new);
-    let (x, _) = sample(motion.as_ref(), &s.x, t0);
+    let (x, v) = sample(motion.as_ref(), &s.x, t0);
     let mut surface = Surface::new(&s.elements, x, 0)
         .map_err(|err| field_error(case, "fluid.embedded.surface", err))?;
+    // The motion's velocity at t0: the first step's Hermite path starts from it.
+    surface.v_a.clone_from(&v);
+    surface.v_b = v;
     surface.t_a = t0;
     surface.t_b = t0;
     let mut seeds: Vec<Seed> =
