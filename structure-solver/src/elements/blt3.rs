@@ -19,6 +19,7 @@ mod strain;
 
 pub use strain::{frame, rows, Frame, Rows, N_DOF};
 
+use super::add_node_masses;
 use super::section::{RotaryInertia, SHEAR_FACTOR};
 use crate::material::{ThicknessRule, J2};
 use strain::{apply, dot};
@@ -158,13 +159,7 @@ impl Blt3 {
             let a = frame(&c.map(|n| x[n as usize])).area;
             let m = rho * h * a / 3.0;
             let i = self.settings.rotary.of_node(m, h, a);
-            for &n in c {
-                let n = n as usize;
-                for k in 0..3 {
-                    mass[6 * n + k] += m;
-                    mass[6 * n + 3 + k] += i;
-                }
-            }
+            add_node_masses(mass, c, m, i);
         }
     }
 

@@ -18,3 +18,16 @@ pub mod tet4;
 
 pub use element::{Element, ElementKind};
 pub use section::{BeamSection, BeamYield, RotaryInertia, ShellSection, ShellYield};
+
+/// Adds the lumped translational mass `m` and rotary inertia `i` of one shell element to each of
+/// its `nodes` (six dofs per node, `mass[6n..6n + 3]` translations, `mass[6n + 3..6n + 6]`
+/// rotations).
+pub(crate) fn add_node_masses(mass: &mut [f64], nodes: &[u32], m: f64, i: f64) {
+    for &n in nodes {
+        let n = n as usize;
+        for k in 0..3 {
+            mass[6 * n + k] += m;
+            mass[6 * n + 3 + k] += i;
+        }
+    }
+}

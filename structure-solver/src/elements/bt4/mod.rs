@@ -32,6 +32,7 @@ mod kernel;
 pub use forces::{SimdPath, BLOCKS_PER_TASK};
 
 use super::section::{RotaryInertia, SHEAR_FACTOR};
+use crate::elements::add_node_masses;
 use crate::material::{ThicknessRule, J2};
 use kernel::{frame, Constants};
 
@@ -241,13 +242,7 @@ impl Bt4 {
             let a = frame(&xe).area;
             let m = rho * h * a / 4.0;
             let i = self.settings.rotary.of_node(m, h, a);
-            for &n in c {
-                let n = n as usize;
-                for k in 0..3 {
-                    mass[6 * n + k] += m;
-                    mass[6 * n + 3 + k] += i;
-                }
-            }
+            add_node_masses(mass, c, m, i);
         }
     }
 
