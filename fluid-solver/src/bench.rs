@@ -118,27 +118,10 @@ pub fn run(
     let start = Instant::now();
     let mesh = Mesh::build(BoxSpec::uniform([0.0; 3], [1.0; 3], [n, n, n], BoxCells::Tet).raw()?)?;
     let mesh_build_seconds = start.elapsed().as_secs_f64();
-    let gamma = 1.4;
-    let eos = Eos::PerfectGas { gamma };
-    let free = [1.0, 0.3, 0.1, 0.0, 1.0];
-    let bcs: Vec<(String, BoundaryCondition)> = FACE_NAMES
-        .iter()
-        .map(|f| (f.to_string(), BoundaryCondition::FarField { state: free }))
-        .collect();
     let two_mesh = mesh.clone();
-    let semi = Semidiscretization::new(mesh, eos, Numerics::default(), &bcs)?;
-    let initial = State::new(
-        semi.mesh
-            .coords
-            .iter()
-            .map(|x| {
-                let s = (6.0 * x[0]).sin() * (5.0 * x[1]).cos() * (4.0 * x[2] + 1.0).sin();
-                eos.prim_to_cons(&[1.0 + 0.2 * s, 0.3 + 0.1 * s, 0.1, 0.05 * s, 1.0 + 0.3 * s])
-            })
-            .collect(),
-    );
+    let (semi, initial) = single_material(mesh)?;
     let single = measure(&semi, &initial, steps, threads, |ws| match dump_edges {
-        Some(path) => dump(path, &semi, ws, gamma),
+        Some(path) => dump(path, &semi, ws, GAMMA),
         None => Ok(()),
     })?;
     let n_nodes = semi.mesh.n_nodes();
@@ -163,6 +146,33 @@ pub fn run(
         speedup_2_threads,
         two_material,
     })
+}
+
+/// γ of the single-material row's perfect gas.
+const GAMMA: f64 = 1.4;
+
+/// The single-material row's scheme and state on `mesh`: a perfect gas between far-field
+/// boundaries, `[ρ, u, v, w, p] = [1 + 0.2s, 0.3 + 0.1s, 0.1, 0.05s, 1 + 0.3s]` with
+/// `s = sin 6x cos 5y sin(4z + 1)`.
+pub(crate) fn single_material(mesh: Mesh) -> anyhow::Result<(Semidiscretization, State)> {
+    let eos = Eos::PerfectGas { gamma: GAMMA };
+    let free = [1.0, 0.3, 0.1, 0.0, 1.0];
+    let bcs: Vec<(String, BoundaryCondition)> = FACE_NAMES
+        .iter()
+        .map(|f| (f.to_string(), BoundaryCondition::FarField { state: free }))
+        .collect();
+    let semi = Semidiscretization::new(mesh, eos, Numerics::default(), &bcs)?;
+    let initial = State::new(
+        semi.mesh
+            .coords
+            .iter()
+            .map(|x| {
+                let s = (6.0 * x[0]).sin() * (5.0 * x[1]).cos() * (4.0 * x[2] + 1.0).sin();
+                eos.prim_to_cons(&[1.0 + 0.2 * s, 0.3 + 0.1 * s, 0.1, 0.05 * s, 1.0 + 0.3 * s])
+            })
+            .collect(),
+    );
+    Ok((semi, initial))
 }
 
 /// The two-material row: the same box, water (stiffened gas, γ 4.4, p_c 6e8) for `x < 0.5` and

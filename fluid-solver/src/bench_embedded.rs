@@ -1,24 +1,34 @@
 //! `fluid-solver bench --embedded`: the cost of the embedded boundary (DESIGN §5.1 "Each step")
-//! on the bench's tet box, beside the single-material RK2 step of [`crate::bench`]:
+//! on the bench's tet box, beside the single-material RK2 step of [`crate::bench`], in the same
+//! run and on the same flow (its perfect gas, state and far field):
 //! - a closed capped cylinder (`cylinder`, 100 x 50 facets + caps = 10,200 triangles) tracked by
-//!   Alg. 4.2 and by Alg. 4.1, and an open tilted plate (200 x 100 quads = 40,000 triangles) by
-//!   Alg. 4.2, each translated by 0.3 cells per step: seconds of `Tracker::advance` and of its
-//!   parts (refit, intersect, swept nodes, sides), of `fill_changed`, and the tracking share
-//!   `(advance + fill) / (advance + fill + RK2 step)`;
+//!   Alg. 4.2 and by Alg. 4.1, and a thin wing, an open tilted plate (200 x 100 quads = 40,000
+//!   triangles), by Alg. 4.2, each translated at the speed that moves it 0.3 cells per CFL step:
+//!   whole steps of [`EmbeddedRun::step`] (CFL step, tracking, filling the uncovered nodes, the
+//!   step's view with its masked gradient, the two RK2 stages with the wall fluxes, `p*` and the
+//!   loads), their node-steps/s/core and its ratio to the single-material row, the tracking
+//!   share of the step, and the split of the tracking into its parts (timed one by one on a
+//!   second tracker given the same motion, and checked against the run's), with the passes over
+//!   the whole mesh they replace (the intersection of every edge, a new step view);
 //! - the wall fluxes (Alg. 5.1, `add_wall_fluxes`) over every cut edge of the cylinder, one
 //!   thread: nanoseconds per cut edge and the share of one single-material residual;
-//! - bytes per node of the embedded state (tracker arrays, surface, hierarchy, the per-node
-//!   material index the wall fluxes read and the cut mask the fill reads).
+//! - bytes per node of the embedded state (tracker arrays and the hierarchy over the mesh nodes,
+//!   surface, surface hierarchy, the step view, the per-node material index the wall fluxes read
+//!   and the cut mask the fill reads);
+//! - the load average of the machine before and after (the machine may be shared: compare the
+//!   ratios, which are measured side by side).
 
-use crate::bench::{median, BenchReport};
-use crate::embedded::adjacency::NodeEdges;
-use crate::embedded::bvh::Bvh;
+use crate::bench::{median, single_material, BenchReport};
+use crate::embedded::advance::EmbeddedRun;
+use crate::embedded::case::Prescribed;
 use crate::embedded::fill::fill_changed;
 use crate::embedded::generate::{cylinder, plate};
-use crate::embedded::intersect::{collision, projection, Intersections, SurfaceAt};
+use crate::embedded::intersect::{collision, projection, Near, SurfaceAt};
+use crate::embedded::motion::RigidMotion;
 use crate::embedded::riemann_fs::{add_wall_fluxes, WallFluxView, WallMaterial};
-use crate::embedded::status::{swept_nodes, update_sides};
-use crate::embedded::tracker::{Seed, Tracker};
+use crate::embedded::status::{swept_nodes_among, update_sides, NodeStatus};
+use crate::embedded::step::EmbeddedStep;
+use crate::embedded::tracker::{intersect, Seed, Tracker};
 use crate::embedded::Surface;
 use crate::eos::Eos;
 use crate::flux::FluxScheme;
@@ -26,29 +36,44 @@ use crate::mesh::blocks::Window;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec};
 use crate::mesh::Mesh;
 use crate::riemann::PressureCutoff;
-use interface_protocol::case::Tracking;
+use crate::semidiscretization::Semidiscretization;
+use crate::state::{State, Workspace};
+use crate::time::cfl::stable_time_step;
+use interface_protocol::case::{LoadAlgorithm, Motion, Tracking};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
 /// Translation per step, in fluid cells.
 const SHIFT_CELLS: f64 = 0.3;
+/// Courant number of the embedded steps (the single-material row's).
+const CFL: f64 = 0.9;
 
 /// One case at one thread count (medians over the timed steps).
 #[derive(Debug, Clone, Serialize)]
 pub struct TrackingMeasurement {
     pub threads: usize,
-    /// `Tracker::advance` as a whole.
-    pub advance_seconds: f64,
-    /// Its parts, timed one by one on a second tracker given the same motion: `refit` (surface
-    /// advance + hierarchy refit), `intersect` (Alg. 4.1 or 4.2), `swept_nodes`, `update_sides`.
-    pub advance_split_seconds: BTreeMap<String, f64>,
-    /// The cut mask and `fill_changed` for the nodes that changed.
-    pub fill_seconds: f64,
-    /// One single-material RK2 step on the same mesh (from the bench row).
-    pub rk2_step_seconds: f64,
-    /// `(advance + fill) / (advance + fill + rk2_step)`.
+    /// One whole step with the surface ([`EmbeddedRun::step`]).
+    pub step_seconds: f64,
+    pub node_steps_per_second_per_core: f64,
+    /// This row's node-steps/s/core over the single-material row's at this thread count.
+    pub ratio_to_single_material: f64,
+    pub single_material_step_seconds: f64,
+    /// The step's tracking: advance, fill, step view (`EmbeddedRun::tracking_s`).
+    pub tracking_seconds: f64,
+    /// `tracking_seconds / step_seconds`.
     pub tracking_share: f64,
+    /// `p*` and the nodal loads at the end of the step.
+    pub loads_seconds: f64,
+    /// The parts of the tracking: `refit` (surface advance + hierarchy refit), `near` (the mesh
+    /// nodes and edges the swept boxes reach), `intersect` (Alg. 4.1 or 4.2 over them),
+    /// `swept_nodes`, `update_sides`, `fill` (cut mask + `fill_changed`), `step_update` (the
+    /// step view and its masked gradient, updated).
+    pub tracking_split_seconds: BTreeMap<String, f64>,
+    /// At the last step: `intersect` over every node and edge, and `step_new` (the step view and
+    /// its gradient built anew), the passes the split's `near` + `intersect` and `step_update`
+    /// replace (same results, checked).
+    pub full_pass_seconds: BTreeMap<String, f64>,
 }
 
 /// One surface and algorithm.
@@ -58,10 +83,15 @@ pub struct TrackingCase {
     pub tracking: &'static str,
     pub triangles: usize,
     pub surface_nodes: usize,
+    /// Surface speed (the step moves it about `shift_cells_per_step` cells).
+    pub speed: f64,
     /// At the last step.
     pub cut_edges: usize,
     pub occluded_nodes: usize,
+    pub inactive_nodes: usize,
     /// Means over the timed steps.
+    pub near_nodes_per_step: f64,
+    pub near_edges_per_step: f64,
     pub swept_nodes_per_step: f64,
     pub changed_nodes_per_step: f64,
     pub measurements: Vec<TrackingMeasurement>,
@@ -72,7 +102,7 @@ pub struct TrackingCase {
 pub struct WallFluxCost {
     pub cut_edges: usize,
     pub ns_per_cut_edge: f64,
-    /// Seconds of all wall fluxes.
+    /// Seconds of all wall fluxes of one residual.
     pub seconds: f64,
     /// Primitives + gradients + fluxes and boundary of the bench row, one thread.
     pub residual_seconds: f64,
@@ -86,6 +116,9 @@ pub struct EmbeddedReport {
     pub cell_size: f64,
     pub shift_cells_per_step: f64,
     pub steps: usize,
+    /// `/proc/loadavg` (1, 5, 15 minutes) before and after the embedded rows.
+    pub load_average_before: Option<[f64; 3]>,
+    pub load_average_after: Option<[f64; 3]>,
     pub cases: Vec<TrackingCase>,
     pub wall_fluxes: WallFluxCost,
     /// Bytes per node of each part of the embedded state of the cylinder (Alg. 4.2).
@@ -103,16 +136,26 @@ struct CaseSpec {
     seeds: Vec<Seed>,
 }
 
+/// The machine's load average, where `/proc/loadavg` tells it.
+fn load_average() -> Option<[f64; 3]> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    let mut it = text.split_whitespace().map(|w| w.parse::<f64>().ok());
+    Some([it.next()??, it.next()??, it.next()??])
+}
+
 /// Runs the embedded rows on the bench's box of about `nodes` nodes for `steps` steps, beside
 /// the single-material `fluid` row measured on it (its thread counts are reused).
 pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<EmbeddedReport> {
     anyhow::ensure!(steps > 0, "--steps must be at least 1");
+    let load_average_before = load_average();
     let n = ((nodes as f64).cbrt().round() as usize).max(3) - 1;
     let mesh = Mesh::build(BoxSpec::uniform([0.0; 3], [1.0; 3], [n, n, n], BoxCells::Tet).raw()?)?;
     anyhow::ensure!(
         mesh.n_nodes() == fluid.nodes,
         "embedded bench on another mesh than the fluid row"
     );
+    let (semi, initial) = single_material(mesh)?;
+    let mesh = &semi.mesh;
     let h = 1.0 / n as f64;
     let outside = Seed { point: [0.02; 3], fluid: true };
     let cyl = cylinder([0.4, 0.5, 0.2], [0.4, 0.5, 0.8], 0.2, [100, 50], true);
@@ -132,44 +175,41 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
             seeds: vec![outside, inside],
         },
         CaseSpec {
-            name: "tilted plate",
+            name: "thin wing (tilted plate)",
             tracking: Tracking::Collision,
             surface: Surface::new(&wing.elements, wing.x.clone(), 0)?,
             seeds: vec![outside],
         },
     ];
-    let prim: Vec<[f64; 5]> = mesh
-        .coords
-        .iter()
-        .map(|x| {
-            let s = (6.0 * x[0]).sin() * (5.0 * x[1]).cos() * (4.0 * x[2] + 1.0).sin();
-            [1.0 + 0.2 * s, 0.3 + 0.1 * s, 0.1, 0.05 * s, 1.0 + 0.3 * s]
-        })
-        .collect();
+    let mut ws = Workspace::new(mesh.n_nodes());
+    let dt0 = CFL * stable_time_step(&semi, &initial.cons, &mut ws)?;
+    let speed = SHIFT_CELLS * h / dt0;
+    let dir = std::env::temp_dir().join(format!("fiver-bench-embedded-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
     let mut cases = Vec::new();
     for spec in &specs {
         let mut case = None;
         let mut measurements = Vec::new();
         for m in &fluid.measurements {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(m.threads).build()?;
-            let (c, t) = pool.install(|| track(&mesh, spec, steps, h, &prim))?;
-            let tracking = t.advance_seconds + t.fill_seconds;
-            measurements.push(TrackingMeasurement {
-                threads: m.threads,
-                rk2_step_seconds: m.seconds_per_step,
-                tracking_share: tracking / (tracking + m.seconds_per_step),
-                ..t
-            });
+            let (c, mut t) = pool.install(|| track(&semi, &initial, spec, steps, speed, &dir))?;
+            t.single_material_step_seconds = m.seconds_per_step;
+            t.ratio_to_single_material =
+                t.node_steps_per_second_per_core / m.node_steps_per_second_per_core;
+            measurements.push(t);
             case = Some(c);
         }
         let mut case = case.ok_or_else(|| anyhow::anyhow!("no thread count measured"))?;
         case.measurements = measurements;
         cases.push(case);
     }
+    std::fs::remove_dir_all(&dir)?;
     // Wall fluxes and memory on the cylinder by Alg. 4.2 at rest.
     let spec = &specs[0];
-    let tracker = Tracker::new(&mesh, spec.surface.clone(), spec.tracking, &spec.seeds)?;
-    let wall_fluxes = wall_flux_cost(&mesh, &tracker, &prim, fluid)?;
+    let tracker = Tracker::new(mesh, spec.surface.clone(), spec.tracking, &spec.seeds)?;
+    let prim: Vec<[f64; 5]> = initial.cons.iter().map(|w| semi.eos[0].cons_to_prim(w)).collect();
+    let wall_fluxes = wall_flux_cost(mesh, &tracker, &prim, fluid)?;
+    let step = EmbeddedStep::new(&semi, &tracker, None);
     let mut split = BTreeMap::new();
     let s = &tracker.surface;
     let surface_bytes = std::mem::size_of_val(&s.triangles[..])
@@ -179,6 +219,7 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
     split.insert("tracker".to_string(), tracker.memory_bytes());
     split.insert("surface".to_string(), surface_bytes);
     split.insert("bvh".to_string(), tracker.bvh.memory_bytes());
+    split.insert("step_view".to_string(), step.memory_bytes());
     split.insert("material".to_string(), mesh.n_nodes());
     split.insert("cut_mask".to_string(), mesh.n_edges());
     let per_node = |b: usize| b as f64 / mesh.n_nodes() as f64;
@@ -188,6 +229,8 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
         cell_size: h,
         shift_cells_per_step: SHIFT_CELLS,
         steps,
+        load_average_before,
+        load_average_after: load_average(),
         cases,
         wall_fluxes,
         bytes_per_node_split: split.into_iter().map(|(k, v)| (k, per_node(v))).collect(),
@@ -196,46 +239,53 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
     })
 }
 
-/// Tracks one case through `1 + steps` translations (the first untimed) in the current pool.
+/// Runs one case through `1 + steps` whole steps (the first untimed) in the current pool, the
+/// surface translated along x at `speed`, with a second tracker advanced part by part beside.
 fn track(
-    mesh: &Mesh,
+    semi: &Semidiscretization,
+    initial: &State,
     spec: &CaseSpec,
     steps: usize,
-    h: f64,
-    prim: &[[f64; 5]],
+    speed: f64,
+    dir: &std::path::Path,
 ) -> anyhow::Result<(TrackingCase, TrackingMeasurement)> {
-    let mut tracker = Tracker::new(mesh, spec.surface.clone(), spec.tracking, &spec.seeds)?;
-    // A second tracker given the same motion, advanced part by part.
+    let mesh = &semi.mesh;
+    let velocity = [speed, 0.0, 0.0];
+    let mut surface = spec.surface.clone();
+    surface.v_a = vec![velocity; surface.n_nodes()];
+    surface.v_b.clone_from(&surface.v_a);
+    let tracker = Tracker::new(mesh, surface, spec.tracking, &spec.seeds)?;
     let mut parts = tracker.clone();
-    let x0 = spec.surface.x_b.clone();
-    let shift = SHIFT_CELLS * h;
-    let v = vec![[shift, 0.0, 0.0]; x0.len()];
-    let (mut advance, mut fill) = (Vec::new(), Vec::new());
+    let mut parts_step = EmbeddedStep::new(semi, &parts, None);
+    let prescribed = Prescribed {
+        tracker,
+        motion: Some(RigidMotion::new(Motion::Translation { velocity })),
+        reference: spec.surface.x_b.clone(),
+        loads: LoadAlgorithm::Reconstructed,
+    };
+    let mut run = EmbeddedRun::new(prescribed, None, dir)?;
+    let mut state = initial.clone();
+    let mut ws = Workspace::new(mesh.n_nodes());
+    let mut t = 0.0;
+    let mut per_step: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
     let mut split: BTreeMap<String, Vec<f64>> = BTreeMap::new();
-    let (mut swept_total, mut changed_total) = (0usize, 0usize);
+    let mut full = BTreeMap::new();
+    let mut counts = [0usize; 4];
     for k in 0..=steps {
-        let t_b = (k + 1) as f64;
-        let x_b: Vec<[f64; 3]> = x0.iter().map(|p| [p[0] + shift * t_b, p[1], p[2]]).collect();
-        let was_active = tracker.active.clone();
-        let start = Instant::now();
-        let changes = tracker.advance(mesh, t_b, &x_b, &v)?;
-        let t_advance = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let cut = tracker.cuts.cut_mask(mesh.n_edges());
-        let filled = fill_changed(
-            mesh,
-            &tracker.adjacency,
-            &changes,
-            &tracker.sides,
-            &was_active,
-            &cut,
-            prim,
-            |_, _| true,
-        )?;
-        let t_fill = start.elapsed().as_secs_f64();
-        std::hint::black_box(filled);
-
         let timed = k > 0;
+        let (tracking0, loads0) = (run.tracking_s, run.loads_s);
+        let start = Instant::now();
+        let dt = run.step(semi, &mut state, &mut ws, CFL, t, f64::INFINITY)?;
+        let step_seconds = start.elapsed().as_secs_f64();
+        t += dt;
+        if timed {
+            per_step.entry("step").or_default().push(step_seconds);
+            per_step.entry("tracking").or_default().push(run.tracking_s - tracking0);
+            per_step.entry("loads").or_default().push(run.loads_s - loads0);
+        }
+        // The same motion, part by part.
+        let (x_b, v_b) = run.prescribed.sample(t);
+        let was_active = parts.active.clone();
         let mut lap = Instant::now();
         let mut stamp = |name: &str, lap: &mut Instant| {
             if timed {
@@ -243,31 +293,75 @@ fn track(
             }
             *lap = Instant::now();
         };
-        parts.surface.advance(t_b, &x_b, &v);
+        parts.surface.advance(t, &x_b, &v_b);
         parts.bvh.update(&parts.surface);
         stamp("refit", &mut lap);
-        let cuts = intersect(mesh, &parts.adjacency, &parts.surface, &parts.bvh, spec.tracking)?;
+        let near = Near::find(mesh, &parts.adjacency, &parts.node_boxes, &parts.bvh);
+        stamp("near", &mut lap);
+        let cuts =
+            intersect(mesh, &parts.adjacency, &parts.surface, &parts.bvh, spec.tracking, &near)?;
         stamp("intersect", &mut lap);
-        let swept = swept_nodes(mesh, &parts.surface, &parts.bvh);
+        let swept = swept_nodes_among(mesh, &parts.surface, &parts.bvh, &near.nodes);
         stamp("swept_nodes", &mut lap);
-        let (sides, part_changes) =
-            update_sides(mesh, &parts.adjacency, &parts.sides, &cuts, &swept);
+        let (sides, changes) = update_sides(mesh, &parts.adjacency, &parts.sides, &cuts, &swept);
         stamp("update_sides", &mut lap);
+        parts.active = sides.status.iter().map(|s| *s == NodeStatus::Active).collect();
+        parts.cuts = cuts;
+        parts.sides = sides;
+        let cut = parts.cuts.cut_mask(mesh.n_edges());
+        let filled = fill_changed(
+            mesh,
+            &parts.adjacency,
+            &changes,
+            &parts.sides,
+            &was_active,
+            &cut,
+            &ws.prim,
+            |_, _| true,
+        )?;
+        std::hint::black_box(filled);
+        stamp("fill", &mut lap);
+        parts_step.update(semi, &parts);
+        stamp("step_update", &mut lap);
+        let tracker = &run.prescribed.tracker;
         anyhow::ensure!(
-            cuts == tracker.cuts && sides == tracker.sides && part_changes == changes,
-            "{} ({:?}), step {k}: the parts disagree with Tracker::advance",
+            parts.cuts == tracker.cuts && parts.sides == tracker.sides,
+            "{} ({:?}), step {k}: the parts disagree with the run's tracker",
             spec.name,
             spec.tracking
         );
-        parts.cuts = cuts;
-        parts.sides = sides;
         if timed {
-            advance.push(t_advance);
-            fill.push(t_fill);
-            swept_total += swept.len();
-            changed_total += changes.len();
+            for (c, v) in counts.iter_mut().zip([
+                near.nodes.len(),
+                near.edges.len(),
+                swept.len(),
+                changes.len(),
+            ]) {
+                *c += v;
+            }
+        }
+        if k == steps {
+            let start = Instant::now();
+            let at = SurfaceAt::at_end(&parts.surface, &parts.bvh)?;
+            let every = match spec.tracking {
+                Tracking::Collision => collision(mesh, &parts.adjacency, at),
+                Tracking::Projection => projection(mesh, &parts.adjacency, at),
+            };
+            full.insert("intersect".to_string(), start.elapsed().as_secs_f64());
+            let start = Instant::now();
+            let fresh = EmbeddedStep::new(semi, &parts, None);
+            full.insert("step_new".to_string(), start.elapsed().as_secs_f64());
+            anyhow::ensure!(
+                every == parts.cuts && fresh == parts_step,
+                "{} ({:?}): the passes over the surface's part of the mesh disagree with the \
+                 passes over the whole mesh",
+                spec.name,
+                spec.tracking
+            );
         }
     }
+    let tracker = &run.prescribed.tracker;
+    let mean = |c: usize| c as f64 / steps as f64;
     let case = TrackingCase {
         name: spec.name,
         tracking: match spec.tracking {
@@ -276,36 +370,32 @@ fn track(
         },
         triangles: tracker.surface.triangles.len(),
         surface_nodes: tracker.surface.n_nodes(),
+        speed,
         cut_edges: tracker.cuts.cuts.len(),
         occluded_nodes: tracker.cuts.occluded.iter().filter(|o| **o).count(),
-        swept_nodes_per_step: swept_total as f64 / steps as f64,
-        changed_nodes_per_step: changed_total as f64 / steps as f64,
+        inactive_nodes: tracker.active.iter().filter(|a| !**a).count(),
+        near_nodes_per_step: mean(counts[0]),
+        near_edges_per_step: mean(counts[1]),
+        swept_nodes_per_step: mean(counts[2]),
+        changed_nodes_per_step: mean(counts[3]),
         measurements: Vec::new(),
     };
+    let mut med = |k: &str| median(per_step.remove(k).unwrap_or_default());
+    let (step, tracking, loads) = (med("step"), med("tracking"), med("loads"));
+    let threads = rayon::current_num_threads();
     let m = TrackingMeasurement {
-        threads: rayon::current_num_threads(),
-        advance_seconds: median(advance),
-        advance_split_seconds: split.into_iter().map(|(k, v)| (k, median(v))).collect(),
-        fill_seconds: median(fill),
-        rk2_step_seconds: f64::NAN,
-        tracking_share: f64::NAN,
+        threads,
+        step_seconds: step,
+        node_steps_per_second_per_core: mesh.n_nodes() as f64 / step / threads as f64,
+        ratio_to_single_material: f64::NAN,
+        single_material_step_seconds: f64::NAN,
+        tracking_seconds: tracking,
+        tracking_share: tracking / step,
+        loads_seconds: loads,
+        tracking_split_seconds: split.into_iter().map(|(k, v)| (k, median(v))).collect(),
+        full_pass_seconds: full,
     };
     Ok((case, m))
-}
-
-/// The cut edges by the case's algorithm (as [`Tracker::advance`] computes them).
-fn intersect(
-    mesh: &Mesh,
-    adjacency: &NodeEdges,
-    surface: &Surface,
-    bvh: &Bvh,
-    tracking: Tracking,
-) -> anyhow::Result<Intersections> {
-    let at = SurfaceAt::at_end(surface, bvh)?;
-    Ok(match tracking {
-        Tracking::Collision => collision(mesh, adjacency, at),
-        Tracking::Projection => projection(mesh, adjacency, at),
-    })
 }
 
 /// Alg. 5.1 over every cut edge of `tracker`, one thread, median of 5.

@@ -28,6 +28,8 @@ pub struct EmbeddedRun {
     /// Seconds spent tracking (refit, intersect, sides, fill) and in the loads.
     pub tracking_s: f64,
     pub loads_s: f64,
+    /// The last step's view of the boundary, updated from step to step.
+    step: Option<EmbeddedStep>,
     forces: ProbeWriter,
 }
 
@@ -48,6 +50,7 @@ impl EmbeddedRun {
             clips: 0,
             tracking_s: 0.0,
             loads_s: 0.0,
+            step: None,
             forces,
         })
     }
@@ -100,12 +103,18 @@ impl EmbeddedRun {
             state.cons[i] = semi.eos_at(i).prim_to_cons(&w);
             ws.prim[i] = w;
         }
-        let step = EmbeddedStep::new(semi, tracker, self.p_cut);
+        let step = match &mut self.step {
+            Some(step) => {
+                step.update(semi, tracker);
+                step
+            }
+            None => self.step.insert(EmbeddedStep::new(semi, tracker, self.p_cut)),
+        };
         self.tracking_s += start.elapsed().as_secs_f64();
-        rk2_step_embedded(semi, state, ws, dt, &step, tracker)?;
+        rk2_step_embedded(semi, state, ws, dt, step, tracker)?;
         let start = std::time::Instant::now();
         semi.primitives(&state.cons, ws)?;
-        let wall = Wall { step: &step, tracker, t: t + dt };
+        let wall = Wall { step, tracker, t: t + dt };
         let (p_star, clips) = wall.pressures(semi, &ws.prim)?;
         self.clips += clips as u64;
         let view = LoadView {

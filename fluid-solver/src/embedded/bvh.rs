@@ -68,27 +68,53 @@ impl Bvh {
     pub fn build(surface: &Surface, pad: f64) -> Bvh {
         let n = surface.triangles.len();
         let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * n.div_ceil(LEAF_SIZE).max(1)),
-            order: (0..n as u32).collect(),
+            nodes: Vec::new(),
+            order: Vec::new(),
             tri_lo: vec![[0.0; 3]; n],
             tri_hi: vec![[0.0; 3]; n],
             pad: pad.max(0.0),
             topology_version: surface.topology_version,
         };
         bvh.triangle_boxes(&surface.triangles, &[&surface.x_a, &surface.x_b]);
-        let centre = |t: u32| {
-            let (lo, hi) = (bvh.tri_lo[t as usize], bvh.tri_hi[t as usize]);
-            [lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]]
+        bvh.split();
+        bvh
+    }
+
+    /// The tree over the given item boxes `[lo[k], hi[k]]` (no padding, topology 0): a static
+    /// hierarchy over anything with a box, such as the fluid mesh's nodes.
+    pub fn over_boxes(lo: Vec<[f64; 3]>, hi: Vec<[f64; 3]>) -> Bvh {
+        debug_assert_eq!(lo.len(), hi.len(), "one upper corner per lower corner");
+        let mut bvh = Bvh {
+            nodes: Vec::new(),
+            order: Vec::new(),
+            tri_lo: lo,
+            tri_hi: hi,
+            pad: 0.0,
+            topology_version: 0,
         };
-        let centres: Vec<[f64; 3]> = (0..n as u32).map(centre).collect();
-        bvh.nodes.push(Node { lo: [0.0; 3], hi: [0.0; 3], first: 0, count: n as u32 });
+        bvh.split();
+        bvh
+    }
+
+    /// The tree structure over the item boxes: median splits, breadth first, then the node boxes.
+    fn split(&mut self) {
+        let n = self.tri_lo.len();
+        self.nodes = Vec::with_capacity(2 * n.div_ceil(LEAF_SIZE).max(1));
+        self.order = (0..n as u32).collect();
+        let centres: Vec<[f64; 3]> = (0..n)
+            .map(|t| {
+                let (lo, hi) = (self.tri_lo[t], self.tri_hi[t]);
+                [lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]]
+            })
+            .collect();
+        self.nodes.push(Node { lo: [0.0; 3], hi: [0.0; 3], first: 0, count: n as u32 });
         // Split breadth-first so that the two children of a node are adjacent.
         let mut k = 0;
-        while k < bvh.nodes.len() {
-            let Node { first, count, .. } = bvh.nodes[k];
+        while k < self.nodes.len() {
+            let Node { first, count, .. } = self.nodes[k];
             let (first, count) = (first as usize, count as usize);
             if count > LEAF_SIZE {
-                let slice = &mut bvh.order[first..first + count];
+                let slice = &mut self.order[first..first + count];
                 let mut lo = [f64::INFINITY; 3];
                 let mut hi = [f64::NEG_INFINITY; 3];
                 for &t in slice.iter() {
@@ -103,12 +129,12 @@ impl Bvh {
                 slice.select_nth_unstable_by(half, |&a, &b| {
                     centres[a as usize][axis].total_cmp(&centres[b as usize][axis]).then(a.cmp(&b))
                 });
-                let child = bvh.nodes.len() as u32;
-                bvh.nodes[k].first = child;
-                bvh.nodes[k].count = 0;
+                let child = self.nodes.len() as u32;
+                self.nodes[k].first = child;
+                self.nodes[k].count = 0;
                 let (f, h) = (first as u32, half as u32);
-                bvh.nodes.push(Node { lo: [0.0; 3], hi: [0.0; 3], first: f, count: h });
-                bvh.nodes.push(Node {
+                self.nodes.push(Node { lo: [0.0; 3], hi: [0.0; 3], first: f, count: h });
+                self.nodes.push(Node {
                     lo: [0.0; 3],
                     hi: [0.0; 3],
                     first: f + h,
@@ -117,8 +143,7 @@ impl Bvh {
             }
             k += 1;
         }
-        bvh.fit_nodes();
-        bvh
+        self.fit_nodes();
     }
 
     /// Makes the tree fit `surface`: rebuilt when its topology version or triangle count
@@ -216,6 +241,35 @@ impl Bvh {
                 top += 2;
             }
         }
+    }
+
+    /// The items of this tree whose boxes overlap an item box of `queries`, ascending: one query
+    /// per leaf of `queries` (its box), each hit then tested against the leaf's item boxes, the
+    /// leaves in parallel.
+    pub fn overlapping(&self, queries: &Bvh) -> Vec<u32> {
+        use rayon::prelude::*;
+        let mut hits: Vec<u32> = queries
+            .nodes
+            .par_iter()
+            .filter(|leaf| leaf.count > 0)
+            .flat_map_iter(|leaf| {
+                let items = &queries.order[leaf.first as usize..(leaf.first + leaf.count) as usize];
+                let mut found = Vec::new();
+                self.for_each_overlap(&leaf.lo, &leaf.hi, |k| {
+                    let (lo, hi) = (&self.tri_lo[k as usize], &self.tri_hi[k as usize]);
+                    if items.iter().any(|&t| {
+                        let t = t as usize;
+                        overlaps(lo, hi, &queries.tri_lo[t], &queries.tri_hi[t])
+                    }) {
+                        found.push(k);
+                    }
+                });
+                found
+            })
+            .collect();
+        hits.par_sort_unstable();
+        hits.dedup();
+        hits
     }
 
     /// Checks the invariants: every parent box contains its children, every leaf box contains its

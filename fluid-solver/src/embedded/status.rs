@@ -146,8 +146,23 @@ pub fn flood_fill(
 /// The nodes a triangle passed over between `x_a` and `x_b` (Alg. 4.2 step 5.1, point against a
 /// linearly moving triangle), ascending. The hierarchy must be fitted to the step ([`Bvh::refit`]).
 pub fn swept_nodes(mesh: &Mesh, surface: &Surface, bvh: &Bvh) -> Vec<u32> {
-    (0..mesh.n_nodes() as u32)
-        .into_par_iter()
+    let all: Vec<u32> = (0..mesh.n_nodes() as u32).collect();
+    swept_nodes_among(mesh, surface, bvh, &all)
+}
+
+/// [`swept_nodes`] among `candidates` (ascending; for example [`Near::nodes`], which holds every
+/// node inside a triangle box).
+///
+/// [`Near::nodes`]: super::intersect::Near
+pub fn swept_nodes_among(
+    mesh: &Mesh,
+    surface: &Surface,
+    bvh: &Bvh,
+    candidates: &[u32],
+) -> Vec<u32> {
+    candidates
+        .par_iter()
+        .copied()
         .filter(|&i| {
             let p = mesh.coords[i as usize];
             let mut swept = false;
@@ -167,7 +182,8 @@ pub fn swept_nodes(mesh: &Mesh, surface: &Surface, bvh: &Bvh) -> Vec<u32> {
 /// Sides after a step (Alg. 4.2 step 5.2): the swept nodes and the nodes occluded before or now
 /// are redecided from their visible neighbours of known side, through the new cut edges, by a
 /// flood fill in node order; those that reach none are inactive. Returns the new sides and the
-/// nodes whose side or status changed (ascending).
+/// nodes whose side or status changed (ascending). The fill starts from the neighbours of the
+/// undecided nodes and walks only what it reaches, so its cost follows the surface.
 pub fn update_sides(
     mesh: &Mesh,
     adjacency: &NodeEdges,
@@ -177,7 +193,7 @@ pub fn update_sides(
 ) -> (NodeSides, Vec<SideChange>) {
     let n = mesh.n_nodes();
     debug_assert!(old.side.len() == n && cuts.occluded.len() == n, "sides of another mesh");
-    let cut = cuts.cut_mask(mesh.n_edges());
+    let uncut = |e: u32| cuts.find(e).is_none();
     let mut side = old.side.clone();
     for &i in swept {
         side[i as usize] = NO_SIDE;
@@ -188,18 +204,23 @@ pub fn update_sides(
         }
     }
     let unknown: Vec<bool> = (0..n).map(|i| side[i] == NO_SIDE && !cuts.occluded[i]).collect();
-    let mut queue: Vec<usize> = (0..n)
-        .filter(|&i| {
-            side[i] != NO_SIDE
-                && adjacency.neighbours(mesh, i).any(|(j, e)| unknown[j] && !cut[e as usize])
-        })
-        .collect();
+    // The known nodes next to an unknown one through an uncut edge, in node order.
+    let mut queue: Vec<usize> = Vec::new();
+    for u in (0..n).filter(|&u| unknown[u]) {
+        for (j, e) in adjacency.neighbours(mesh, u) {
+            if side[j] != NO_SIDE && uncut(e) {
+                queue.push(j);
+            }
+        }
+    }
+    queue.sort_unstable();
+    queue.dedup();
     let mut head = 0;
     while head < queue.len() {
         let i = queue[head];
         head += 1;
         for (j, e) in adjacency.neighbours(mesh, i) {
-            if unknown[j] && side[j] == NO_SIDE && !cut[e as usize] {
+            if unknown[j] && side[j] == NO_SIDE && uncut(e) {
                 side[j] = side[i];
                 queue.push(j);
             }

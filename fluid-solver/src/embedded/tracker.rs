@@ -1,14 +1,18 @@
 //! The embedded boundary through a run (DESIGN §5.1, "Each step"): the surface, its hierarchy,
 //! the cut edges and the node sides, advanced one fluid step at a time:
-//! surface at `t_b` -> refit -> intersect (Alg. 4.1 or 4.2 at `x_b`) -> swept nodes and new
+//! surface at `t_b` -> refit -> the mesh nodes and edges the swept boxes reach
+//! ([`super::intersect::near`]) -> intersect (Alg. 4.1 or 4.2 at `x_b`) -> swept nodes and new
 //! sides (Alg. 4.2 step 5) -> the nodes whose status changed, for the solver to fill
-//! ([`super::fill`]). The residual then reads it through [`Tracker::wall_view`].
+//! ([`super::fill`]). The residual then reads it through [`super::step::Wall`]. Only the flood
+//! fill of Alg. 4.1 and a few streaming passes over the node arrays cost what the grid costs.
 
 use super::adjacency::NodeEdges;
 use super::bvh::Bvh;
-use super::intersect::{collision, projection, Intersections, SurfaceAt, SurfaceAtError};
+use super::intersect::{collision_near, projection_near, Intersections, Near, NodeBoxes};
+use super::intersect::{SurfaceAt, SurfaceAtError};
 use super::riemann_fs::WallPressures;
-use super::status::{flood_fill, step_ratio, swept_nodes, update_sides, NodeSides, NodeStatus};
+use super::status::{flood_fill, step_ratio, swept_nodes_among, update_sides};
+use super::status::{NodeSides, NodeStatus};
 use super::status::{SideChange, StatusError};
 use super::Surface;
 use crate::mesh::Mesh;
@@ -37,6 +41,8 @@ pub struct Tracker {
     pub surface: Surface,
     pub bvh: Bvh,
     pub adjacency: NodeEdges,
+    /// The hierarchy over the mesh nodes' reach boxes.
+    pub node_boxes: NodeBoxes,
     pub tracking: Tracking,
     /// Cut edges at the end of the current step (`surface.t_b`).
     pub cuts: Intersections,
@@ -59,11 +65,13 @@ impl Tracker {
         let adjacency = NodeEdges::build(mesh);
         let h = adjacency.h_min.iter().copied().fold(f64::INFINITY, f64::min);
         let bvh = Bvh::build(&surface, PAD * if h.is_finite() { h } else { 0.0 });
-        let cuts = intersect(mesh, &adjacency, &surface, &bvh, tracking)?;
+        let node_boxes = NodeBoxes::build(mesh, &adjacency);
+        let near = Near::find(mesh, &adjacency, &node_boxes, &bvh);
+        let cuts = intersect(mesh, &adjacency, &surface, &bvh, tracking, &near)?;
         let sides = flood_fill(mesh, &adjacency, &cuts, seeds)?;
         let active = sides.status.iter().map(|s| *s == NodeStatus::Active).collect();
         let p_star = vec![[f64::NAN; 2]; cuts.cuts.len()];
-        Ok(Tracker { surface, bvh, adjacency, tracking, cuts, sides, active, p_star })
+        Ok(Tracker { surface, bvh, adjacency, node_boxes, tracking, cuts, sides, active, p_star })
     }
 
     /// Moves the surface to `(x_b, v_b)` at `t_b` and re-tracks it: returns the nodes whose side
@@ -81,8 +89,10 @@ impl Tracker {
         }
         self.surface.advance(t_b, x_b, v_b);
         self.bvh.update(&self.surface);
-        let cuts = intersect(mesh, &self.adjacency, &self.surface, &self.bvh, self.tracking)?;
-        let swept = swept_nodes(mesh, &self.surface, &self.bvh);
+        let near = Near::find(mesh, &self.adjacency, &self.node_boxes, &self.bvh);
+        let cuts =
+            intersect(mesh, &self.adjacency, &self.surface, &self.bvh, self.tracking, &near)?;
+        let swept = swept_nodes_among(mesh, &self.surface, &self.bvh, &near.nodes);
         let (sides, changes) = update_sides(mesh, &self.adjacency, &self.sides, &cuts, &swept);
         self.cuts = cuts;
         self.sides = sides;
@@ -99,10 +109,12 @@ impl Tracker {
         step_ratio(mesh, &self.surface, &self.cuts)
     }
 
-    /// Memory in bytes of the per-node and per-cut arrays (the surface and tree not counted).
+    /// Memory in bytes of the per-node and per-cut arrays and the hierarchy over the mesh nodes
+    /// (the surface and its tree not counted).
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of_val;
         self.adjacency.memory_bytes()
+            + self.node_boxes.memory_bytes()
             + size_of_val(&self.cuts.cuts[..])
             + size_of_val(&self.cuts.occluded[..])
             + size_of_val(&self.sides.status[..])
@@ -112,17 +124,19 @@ impl Tracker {
     }
 }
 
-/// The cut edges of the surface at `x_b` by the case's algorithm.
-fn intersect(
+/// The cut edges of the surface at `x_b` by the case's algorithm, testing the nodes and edges of
+/// `near` ([`Near::find`] over `bvh`).
+pub fn intersect(
     mesh: &Mesh,
     adjacency: &NodeEdges,
     surface: &Surface,
     bvh: &Bvh,
     tracking: Tracking,
+    near: &Near,
 ) -> Result<Intersections, TrackError> {
     let at = SurfaceAt::at_end(surface, bvh)?;
     Ok(match tracking {
-        Tracking::Collision => collision(mesh, adjacency, at),
-        Tracking::Projection => projection(mesh, adjacency, at),
+        Tracking::Collision => collision_near(mesh, adjacency, at, near),
+        Tracking::Projection => projection_near(mesh, adjacency, at, near),
     })
 }

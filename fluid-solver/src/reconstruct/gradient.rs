@@ -13,7 +13,8 @@
 //! Edge masks: [`LsqGradient::with_mask`] drops edges (edges cut by the embedded structure, or
 //! joining different fluids, DESIGN §5); the matrices of their end nodes are built from the
 //! remaining edges. A node whose remaining neighbours do not span 3D gets a zero gradient
-//! (first-order reconstruction there).
+//! (first-order reconstruction there). [`LsqGradient::remask`] changes the mask at some edges and
+//! rebuilds only the matrices of their end nodes, bitwise as a new build would.
 //!
 //! # Mirror planes (symmetry planes and plane slip walls)
 //!
@@ -75,7 +76,7 @@ pub const VELOCITY: Range<usize> = 1..4;
 const PLANE_TOLERANCE: f64 = 1e-6;
 
 /// Precomputed least-squares gradient operator of a mesh.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct LsqGradient {
     /// Per node, `M_i⁻¹` (`M̄_i⁻¹` at nodes on mirror planes) as `[xx, xy, xz, yy, yz, zz]`
     /// (zero where the matrix is singular).
@@ -148,6 +149,11 @@ impl MirrorPlanes {
         self.nodes.is_empty()
     }
 
+    /// The planes of node `i`, in patch order.
+    fn of_node(&self, i: usize) -> &[[f64; 3]] {
+        &self.normals[self.entries(&(i..i + 1))]
+    }
+
     /// The entries of the nodes in `nodes`.
     fn entries(&self, nodes: &Range<usize>) -> Range<usize> {
         self.nodes.partition_point(|&v| (v as usize) < nodes.start)
@@ -209,6 +215,23 @@ fn invert_sym3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     ])
 }
 
+/// Adds the term `w d dᵀ` of the edge `(i, j)` (`d = x_j - x_i`, `w = 1/|d|²`) to `m`.
+#[inline]
+fn add_edge_moment(m: &mut [[f64; 3]; 3], mesh: &Mesh, [i, j]: [u32; 2]) {
+    let d = sub(mesh.coords[j as usize], mesh.coords[i as usize]);
+    let w = 1.0 / dot(d, d);
+    for a in 0..3 {
+        for b in 0..3 {
+            m[a][b] += w * d[a] * d[b];
+        }
+    }
+}
+
+/// `M⁻¹` as `[xx, xy, xz, yy, yz, zz]`, zero where `M` is singular.
+fn packed_inverse(m: &[[f64; 3]; 3]) -> [f64; 6] {
+    invert_sym3(m).map_or([0.0; 6], |v| [v[0][0], v[0][1], v[0][2], v[1][1], v[1][2], v[2][2]])
+}
+
 impl LsqGradient {
     /// The operator using every edge, without mirror planes.
     pub fn new(mesh: &Mesh) -> LsqGradient {
@@ -229,27 +252,63 @@ impl LsqGradient {
             if mask.is_some_and(|m| !m[e]) {
                 continue;
             }
-            let d = sub(mesh.coords[j as usize], mesh.coords[i as usize]);
-            let w = 1.0 / dot(d, d);
             for node in [i as usize, j as usize] {
-                for a in 0..3 {
-                    for b in 0..3 {
-                        m[node][a][b] += w * d[a] * d[b];
-                    }
-                }
+                add_edge_moment(&mut m[node], mesh, [i, j]);
             }
         }
         for (&i, n) in planes.nodes.iter().zip(&planes.normals) {
             mirror_symmetric(&mut m[i as usize], n);
         }
-        let inverses = m
+        let inverses = m.par_iter().map(packed_inverse).collect();
+        LsqGradient { inverses, mask: mask.map(<[bool]>::to_vec), planes }
+    }
+
+    /// Flips the mask at the edges `flipped` (each listed once) and rebuilds the matrices of
+    /// their end nodes from their edges `edges_of(i)` (ascending, every edge of `i`), so that the
+    /// operator is bitwise the one [`LsqGradient::with_planes`] builds with the new mask: the
+    /// same sums in the same (edge) order, then the same planes and inversion.
+    pub fn remask<'a>(
+        &mut self,
+        mesh: &Mesh,
+        flipped: &[u32],
+        edges_of: impl Fn(usize) -> &'a [u32] + Sync,
+    ) {
+        if flipped.is_empty() {
+            return;
+        }
+        let mask = self.mask.get_or_insert_with(|| vec![true; mesh.n_edges()]);
+        let mut nodes = Vec::with_capacity(2 * flipped.len());
+        for &e in flipped {
+            mask[e as usize] = !mask[e as usize];
+            nodes.extend(mesh.edges[e as usize]);
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        let (mask, planes) = (&*mask, &self.planes);
+        let rebuilt: Vec<[f64; 6]> = nodes
             .par_iter()
-            .map(|m| {
-                invert_sym3(m)
-                    .map_or([0.0; 6], |v| [v[0][0], v[0][1], v[0][2], v[1][1], v[1][2], v[2][2]])
+            .map(|&i| {
+                let i = i as usize;
+                let mut m = [[0.0; 3]; 3];
+                for &e in edges_of(i) {
+                    if mask[e as usize] {
+                        add_edge_moment(&mut m, mesh, mesh.edges[e as usize]);
+                    }
+                }
+                for n in planes.of_node(i) {
+                    mirror_symmetric(&mut m, n);
+                }
+                packed_inverse(&m)
             })
             .collect();
-        LsqGradient { inverses, mask: mask.map(<[bool]>::to_vec), planes }
+        for (&i, inv) in nodes.iter().zip(rebuilt) {
+            self.inverses[i as usize] = inv;
+        }
+    }
+
+    /// Whether edge `e` takes part.
+    pub fn uses(&self, e: usize) -> bool {
+        self.mask.as_ref().is_none_or(|m| m[e])
     }
 
     /// The mirror planes of the operator.

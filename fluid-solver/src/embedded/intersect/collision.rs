@@ -12,38 +12,62 @@
 //!
 //! Doubly cut edges of thin bodies are found, and an open surface needs no inside.
 
-use super::{Intersections, SurfaceAt};
+use super::{Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
+use crate::embedded::CutEdge;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 
-/// Cut edges and occluded nodes of `mesh` against the surface at positions `at.x` (Alg. 4.2).
+/// Edges per parallel task.
+const CHUNK: usize = 512;
+
+/// Cut edges and occluded nodes of `mesh` against the surface at positions `at.x` (Alg. 4.2),
+/// testing every node and edge.
 pub fn collision(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Intersections {
+    collision_near(mesh, adjacency, at, &Near::all(mesh))
+}
+
+/// [`collision()`] testing only the nodes and edges of `near` (which must hold every node and
+/// edge the hierarchy's boxes can reach: [`Near::find`]).
+pub fn collision_near(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    at: SurfaceAt<'_>,
+    near: &Near,
+) -> Intersections {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
-    let occluded = at.occluded(mesh, &adjacency.h_min, true);
-    let blocks: Vec<_> = (0..mesh.blocks.len())
-        .into_par_iter()
-        .map(|b| {
-            let mut cuts = Vec::new();
-            for e in mesh.blocks.edges(b) {
-                if let Some(c) = at.nearest_crossing(mesh, e, true) {
-                    cuts.push(c);
-                    continue;
-                }
-                let [i, j] = mesh.edges[e].map(|v| v as usize);
-                // Step 4.2: the occluded end is the intersection point.
-                for (end, alpha) in [(i, 0.0), (j, 1.0)] {
-                    if occluded[end] {
-                        let r = super::OCCLUSION * adjacency.h_min[end];
-                        if let Some((t, cp)) = at.nearest_point(mesh.coords[end], r, true) {
-                            cuts.push(at.cut(e, t, alpha, cp.bary));
-                            break;
-                        }
-                    }
-                }
-            }
-            cuts
+    let occluded = at.occluded(mesh, &adjacency.h_min, true, &near.nodes);
+    let cuts: Vec<CutEdge> = near
+        .edges
+        .par_chunks(CHUNK)
+        .flat_map_iter(|chunk| {
+            chunk.iter().filter_map(|&e| edge_cut(mesh, adjacency, at, &occluded, e as usize))
         })
         .collect();
-    Intersections::from_blocks(blocks, occluded)
+    Intersections::from_sorted(mesh, cuts, occluded)
+}
+
+/// The cut of edge `e`: its crossing nearest to node `i` (step 4), else its occluded end
+/// (step 4.2).
+fn edge_cut(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    at: SurfaceAt<'_>,
+    occluded: &[bool],
+    e: usize,
+) -> Option<CutEdge> {
+    if let Some(c) = at.nearest_crossing(mesh, e, true) {
+        return Some(c);
+    }
+    let [i, j] = mesh.edges[e].map(|v| v as usize);
+    // Step 4.2: the occluded end is the intersection point.
+    for (end, alpha) in [(i, 0.0), (j, 1.0)] {
+        if occluded[end] {
+            let r = super::OCCLUSION * adjacency.h_min[end];
+            if let Some((t, cp)) = at.nearest_point(mesh.coords[end], r, true) {
+                return Some(at.cut(e, t, alpha, cp.bary));
+            }
+        }
+    }
+    None
 }

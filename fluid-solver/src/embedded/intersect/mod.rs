@@ -2,17 +2,21 @@
 //! tested against the triangles near it; open, thin and unresolved surfaces, cracks through phi),
 //! [`projection()`] is Alg. 4.1 (sides by projection and flood fill; closed, resolved surfaces).
 //! Both return [`Intersections`]: one [`CutEdge`] per cut edge, sorted by edge, with the offsets
-//! of each edge block of [`crate::mesh::EdgeBlocks`], and the occluded nodes.
+//! of each edge block of [`crate::mesh::EdgeBlocks`], and the occluded nodes. Each has a form
+//! over the part of the mesh the surface can touch ([`near`]: the tracker's, same result) and a
+//! form over the whole mesh (the reference it is tested against).
 //!
 //! The surface is taken at one set of nodal positions `x` (for example `Surface::x_b`, or
 //! `Surface::node_at` at a stage time); the hierarchy's boxes must hold the triangles there
 //! ([`super::bvh::Bvh::refit`] covers `x_a` and `x_b`, [`super::bvh::Bvh::refit_with`] any other).
 
 pub mod collision;
+pub mod near;
 pub mod projection;
 
-pub use collision::collision;
-pub use projection::{projection, projection_inside};
+pub use collision::{collision, collision_near};
+pub use near::{Near, NodeBoxes};
+pub use projection::{projection, projection_inside, projection_near};
 
 use super::bvh::Bvh;
 use super::predicates::{closest_point, segment_triangle, unit_normal, Closest};
@@ -59,6 +63,16 @@ impl Intersections {
             m[c.edge as usize] = true;
         }
         m
+    }
+
+    /// The sorted list `cuts` cut into the edge blocks of `mesh`.
+    fn from_sorted(mesh: &Mesh, cuts: Vec<CutEdge>, occluded: Vec<bool>) -> Intersections {
+        let blocks = &mesh.blocks;
+        let mut block_offsets: Vec<u32> = (0..blocks.len())
+            .map(|b| cuts.partition_point(|c| (c.edge as usize) < blocks.edges(b).start) as u32)
+            .collect();
+        block_offsets.push(cuts.len() as u32);
+        Intersections { cuts, block_offsets, occluded }
     }
 
     /// Gathers the per-block lists (in block order) into one sorted list with offsets.
@@ -183,18 +197,25 @@ impl SurfaceAt<'_> {
         best
     }
 
-    /// Occluded nodes (Alg. 4.2 step 3.1): within `OCCLUSION * h_min(i)` of the surface.
-    fn occluded(&self, mesh: &Mesh, h_min: &[f64], crack_aware: bool) -> Vec<bool> {
+    /// Occluded nodes (Alg. 4.2 step 3.1): within `OCCLUSION * h_min(i)` of the surface, among
+    /// `nodes` (ascending; the others are not).
+    fn occluded(&self, mesh: &Mesh, h_min: &[f64], crack_aware: bool, nodes: &[u32]) -> Vec<bool> {
         use rayon::prelude::*;
-        (0..mesh.n_nodes())
-            .into_par_iter()
-            .map(|i| {
+        let hit: Vec<bool> = nodes
+            .par_iter()
+            .map(|&i| {
+                let i = i as usize;
                 let r = OCCLUSION * h_min[i];
                 r.is_finite()
                     && self
                         .nearest_point(mesh.coords[i], r, crack_aware)
                         .is_some_and(|(_, c)| c.dist2 <= r * r)
             })
-            .collect()
+            .collect();
+        let mut occluded = vec![false; mesh.n_nodes()];
+        for (&i, h) in nodes.iter().zip(hit) {
+            occluded[i as usize] = h;
+        }
+        occluded
     }
 }

@@ -19,17 +19,29 @@
 //! Fig. 4.5, Case II): [`super::collision()`] is the algorithm for such bodies. Phi is not used:
 //! a cracked surface is not closed.
 
-use super::{Intersections, SurfaceAt};
+use super::{Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::predicates::{closest_point, unit_normal, Closest, Feature};
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 
-/// Cut edges and occluded nodes by Alg. 4.1; the inside test is [`projection_inside`].
+/// Cut edges and occluded nodes by Alg. 4.1; the inside test is [`projection_inside`]. Tests
+/// every node.
 pub fn projection(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Intersections {
-    let inside = projection_inside(mesh, adjacency, at);
-    let occluded = at.occluded(mesh, &adjacency.h_min, false);
+    projection_near(mesh, adjacency, at, &Near::all(mesh))
+}
+
+/// [`projection()`] testing only the nodes of `near` against the surface ([`Near::find`]); the
+/// flood fill and the comparison of the sides of each edge still run over the whole mesh.
+pub fn projection_near(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    at: SurfaceAt<'_>,
+    near: &Near,
+) -> Intersections {
+    let inside = inside_among(mesh, adjacency, at, &near.nodes);
+    let occluded = at.occluded(mesh, &adjacency.h_min, false, &near.nodes);
     let blocks: Vec<_> = (0..mesh.blocks.len())
         .into_par_iter()
         .map(|b| {
@@ -63,12 +75,25 @@ pub fn projection(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Inte
 
 /// Per node: inside the closed surface (Alg. 4.1 steps 1-4).
 pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Vec<bool> {
+    let all: Vec<u32> = (0..mesh.n_nodes() as u32).collect();
+    inside_among(mesh, adjacency, at, &all)
+}
+
+/// [`projection_inside`] with steps 1-3 run only at `candidates` (ascending; a node whose box
+/// meets no triangle box is not near and is left to the flood fill).
+fn inside_among(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    at: SurfaceAt<'_>,
+    candidates: &[u32],
+) -> Vec<bool> {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     let normals = PseudoNormals::new(at);
     // Steps 1-3: the near nodes, decided by their closest point.
-    let near: Vec<Option<bool>> = (0..mesh.n_nodes())
-        .into_par_iter()
-        .map(|i| {
+    let decided: Vec<Option<bool>> = candidates
+        .par_iter()
+        .map(|&i| {
+            let i = i as usize;
             let p = mesh.coords[i];
             let (lo, hi) = adjacency.node_box(mesh, i);
             let mut best: Option<(u32, Closest)> = None;
@@ -91,8 +116,11 @@ pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) 
             Some(dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0)
         })
         .collect();
+    let mut inside: Vec<Option<bool>> = vec![None; mesh.n_nodes()];
+    for (&i, d) in candidates.iter().zip(decided) {
+        inside[i as usize] = d;
+    }
     // Step 4: flood fill from the decided nodes, in node order.
-    let mut inside: Vec<Option<bool>> = near;
     let mut queue: Vec<usize> = (0..mesh.n_nodes()).filter(|&i| inside[i].is_some()).collect();
     let mut head = 0;
     while head < queue.len() {

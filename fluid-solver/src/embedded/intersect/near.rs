@@ -1,0 +1,197 @@
+//! The part of the fluid mesh the surface can touch in a step, so that the tracking passes cost
+//! what the surface costs and not what the grid costs (thesis §4.1: the search structure serves
+//! to "avoid testing every edge against every triangle"; here it also avoids testing every edge).
+//!
+//! Each node's *reach box* is the box of the node and its neighbours ([`NodeEdges::node_box`]),
+//! widened by the occlusion radius `OCCLUSION * h_min(i)`. It holds every edge of the node, the
+//! node's occlusion ball and its projection box (Alg. 4.1 step 1), so a node whose reach box
+//! meets no swept triangle box of the hierarchy is neither near nor occluded nor swept, and an
+//! edge none of whose ends is such a node crosses no triangle: each pass over [`Near`] gives
+//! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
+//! ([`NodeBoxes`], built once with the mesh) is queried with the leaves of the surface's tree.
+
+use super::OCCLUSION;
+use crate::embedded::adjacency::NodeEdges;
+use crate::embedded::bvh::Bvh;
+use crate::mesh::Mesh;
+
+/// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeBoxes {
+    tree: Bvh,
+}
+
+impl NodeBoxes {
+    pub fn build(mesh: &Mesh, adjacency: &NodeEdges) -> NodeBoxes {
+        let n = mesh.n_nodes();
+        let (mut lo, mut hi) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            let (l, h) = adjacency.node_box(mesh, i);
+            let r = OCCLUSION * adjacency.h_min[i];
+            let r = if r.is_finite() { r } else { 0.0 };
+            lo.push(l.map(|v| v - r));
+            hi.push(h.map(|v| v + r));
+        }
+        NodeBoxes { tree: Bvh::over_boxes(lo, hi) }
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.tree.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.tree.is_empty()
+    }
+
+    /// Memory in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        self.tree.memory_bytes()
+    }
+}
+
+/// Mesh nodes and edges, each list ascending: the nodes whose reach box meets a triangle box and
+/// every edge touching one of them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Near {
+    pub nodes: Vec<u32>,
+    pub edges: Vec<u32>,
+}
+
+impl Near {
+    /// Every node and edge (the full passes).
+    pub fn all(mesh: &Mesh) -> Near {
+        Near {
+            nodes: (0..mesh.n_nodes() as u32).collect(),
+            edges: (0..mesh.n_edges() as u32).collect(),
+        }
+    }
+
+    /// The nodes of `boxes` whose reach boxes meet a triangle box of `bvh`, with their edges.
+    pub fn find(mesh: &Mesh, adjacency: &NodeEdges, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
+        debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
+        let nodes = boxes.tree.overlapping(bvh);
+        // The edges of those nodes, ascending, through a bit set over the edges.
+        let mut bits = vec![0u64; mesh.n_edges().div_ceil(64)];
+        for &i in &nodes {
+            for &e in adjacency.edges_of(i as usize) {
+                bits[e as usize / 64] |= 1 << (e % 64);
+            }
+        }
+        let mut edges = Vec::new();
+        for (w, &word) in bits.iter().enumerate() {
+            let mut word = word;
+            while word != 0 {
+                edges.push(64 * w as u32 + word.trailing_zeros());
+                word &= word - 1;
+            }
+        }
+        Near { nodes, edges }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::embedded::intersect::{collision, collision_near, projection, projection_near};
+    use crate::embedded::intersect::{Intersections, SurfaceAt};
+    use crate::embedded::status::{swept_nodes, swept_nodes_among, update_sides};
+    use crate::embedded::tests::{box_surface, cube_mesh, plane, sphere};
+    use crate::embedded::tracker::{Seed, Tracker};
+    use crate::embedded::Surface;
+    use interface_protocol::case::Tracking;
+
+    /// Every pass over `Near::find` gives what the pass over the whole mesh gives, and `Near`
+    /// is much smaller than the mesh.
+    fn assert_same_as_full_passes(mesh: &Mesh, s: &Surface, pad: f64, label: &str) {
+        let adj = NodeEdges::build(mesh);
+        let boxes = NodeBoxes::build(mesh, &adj);
+        let bvh = Bvh::build(s, pad);
+        let near = Near::find(mesh, &adj, &boxes, &bvh);
+        let at = SurfaceAt::at_end(s, &bvh).unwrap();
+        let c42 = collision(mesh, &adj, at);
+        assert_eq!(collision_near(mesh, &adj, at, &near), c42, "{label}: Alg. 4.2");
+        assert_eq!(projection_near(mesh, &adj, at, &near), projection(mesh, &adj, at), "{label}");
+        let swept = swept_nodes(mesh, s, &bvh);
+        assert_eq!(swept_nodes_among(mesh, s, &bvh, &near.nodes), swept, "{label}: swept");
+        assert!(!c42.cuts.is_empty(), "{label}: nothing cut");
+        assert!(near.edges.len() < mesh.n_edges(), "{label}: every edge is near");
+        boxes.tree.validate().unwrap();
+        // What `find` keeps is what the definition says, node by node.
+        let want: Vec<u32> = (0..mesh.n_nodes() as u32)
+            .filter(|&i| {
+                let (lo, hi) = boxes.tree.triangle_box(i as usize);
+                (0..bvh.len()).any(|t| {
+                    let (a, b) = bvh.triangle_box(t);
+                    crate::embedded::bvh::overlaps(&lo, &hi, &a, &b)
+                })
+            })
+            .collect();
+        assert_eq!(near.nodes, want, "{label}");
+        let mut edges: Vec<u32> =
+            want.iter().flat_map(|&i| adj.edges_of(i as usize).to_vec()).collect();
+        edges.sort_unstable();
+        edges.dedup();
+        assert_eq!(near.edges, edges, "{label}");
+    }
+
+    #[test]
+    fn passes_over_the_near_part_equal_the_full_passes_on_the_test_surfaces() {
+        let mesh = cube_mesh(12, 0.3, 5);
+        let h = 1.0 / 12.0;
+        let mut thin = box_surface([0.2, 0.25, 0.53], [0.8, 0.75, 0.53 + 0.1 * h], 2);
+        let moved: Vec<[f64; 3]> = thin.x_b.iter().map(|p| [p[0] + 0.4 * h, p[1], p[2]]).collect();
+        thin.advance(0.1, &moved, &vec![[0.0; 3]; moved.len()]);
+        let mut cracked = plane(-0.2, 1.2, -0.2, 1.2, 0.47);
+        cracked.phi[0] = [-1.0, 1.0, 0.5];
+        let cases = [
+            ("sphere", sphere([0.52, 0.47, 0.5], 0.3, 8), 1e-12),
+            ("box", box_surface([0.3, 0.26, 0.34], [0.71, 0.66, 0.72], 3), 1e-3 * h),
+            ("swept thin box", thin, 1e-12),
+            ("cracked plane", cracked, 0.0),
+        ];
+        for (label, s, pad) in &cases {
+            assert_same_as_full_passes(&mesh, s, *pad, label);
+        }
+        // A plane through mesh nodes: occluded nodes and the cuts at them.
+        let mesh = cube_mesh(6, 0.0, 0);
+        assert_same_as_full_passes(&mesh, &plane(-0.5, 1.5, -0.5, 1.5, 0.5), 1e-12, "on nodes");
+    }
+
+    /// A sphere moving through a perturbed mesh, by both algorithms: the tracker (which tests
+    /// only the near part) has after every step the cuts and sides of the full passes.
+    #[test]
+    fn a_moving_sphere_is_tracked_as_by_the_full_passes() {
+        let mesh = cube_mesh(12, 0.3, 21);
+        let rest = sphere([0.4, 0.5, 0.48], 0.27, 8);
+        let seeds =
+            [Seed { point: [0.0; 3], fluid: true }, Seed { point: [0.4, 0.5, 0.48], fluid: false }];
+        for tracking in [Tracking::Collision, Tracking::Projection] {
+            let mut tracker = Tracker::new(&mesh, rest.clone(), tracking, &seeds).unwrap();
+            let mut full = tracker.sides.clone();
+            let mut changed = 0;
+            for step in 1..=5 {
+                let (shift, t) = (0.04 * step as f64, 0.01 * step as f64);
+                let x: Vec<[f64; 3]> =
+                    rest.x_b.iter().map(|p| [p[0] + shift, p[1], p[2] + 0.3 * shift]).collect();
+                let v = vec![[4.0, 0.0, 1.2]; x.len()];
+                let changes = tracker.advance(&mesh, t, &x, &v).unwrap();
+                let s = &tracker.surface;
+                let at = SurfaceAt::at_end(s, &tracker.bvh).unwrap();
+                let cuts: Intersections = match tracking {
+                    Tracking::Collision => collision(&mesh, &tracker.adjacency, at),
+                    Tracking::Projection => projection(&mesh, &tracker.adjacency, at),
+                };
+                assert_eq!(tracker.cuts, cuts, "{tracking:?}, step {step}");
+                let swept = swept_nodes(&mesh, s, &tracker.bvh);
+                let (sides, full_changes) =
+                    update_sides(&mesh, &tracker.adjacency, &full, &cuts, &swept);
+                assert_eq!(tracker.sides, sides, "{tracking:?}, step {step}");
+                assert_eq!(changes, full_changes);
+                changed += changes.len();
+                full = sides;
+            }
+            assert!(changed > 40, "{tracking:?}: {changed} nodes changed");
+        }
+    }
+}
