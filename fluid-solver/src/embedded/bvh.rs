@@ -243,27 +243,63 @@ impl Bvh {
         }
     }
 
-    /// The items of this tree whose boxes overlap an item box of `queries`, ascending: one query
-    /// per leaf of `queries` (its box), each hit then tested against the leaf's item boxes, the
-    /// leaves in parallel.
+    /// The items of this tree whose boxes overlap an item box of `queries`, ascending, by a
+    /// traversal of both trees at once (pairs of nodes whose boxes overlap, down to pairs of
+    /// leaves, whose items are tested box against box), in parallel over the subtrees of
+    /// `queries` below its first levels.
     pub fn overlapping(&self, queries: &Bvh) -> Vec<u32> {
         use rayon::prelude::*;
-        let mut hits: Vec<u32> = queries
-            .nodes
+        if self.is_empty() || queries.is_empty() {
+            return Vec::new();
+        }
+        // Subtrees of `queries`: the levels below the root, split until there are enough.
+        let mut roots = vec![0u32];
+        while roots.len() < 64 {
+            let next: Vec<u32> = roots
+                .iter()
+                .flat_map(|&r| match queries.nodes[r as usize] {
+                    Node { count: 0, first, .. } => [Some(first), Some(first + 1)],
+                    _ => [Some(r), None],
+                })
+                .flatten()
+                .collect();
+            if next.len() == roots.len() {
+                break;
+            }
+            roots = next;
+        }
+        let mut hits: Vec<u32> = roots
             .par_iter()
-            .filter(|leaf| leaf.count > 0)
-            .flat_map_iter(|leaf| {
-                let items = &queries.order[leaf.first as usize..(leaf.first + leaf.count) as usize];
+            .flat_map_iter(|&q| {
                 let mut found = Vec::new();
-                self.for_each_overlap(&leaf.lo, &leaf.hi, |k| {
-                    let (lo, hi) = (&self.tri_lo[k as usize], &self.tri_hi[k as usize]);
-                    if items.iter().any(|&t| {
-                        let t = t as usize;
-                        overlaps(lo, hi, &queries.tri_lo[t], &queries.tri_hi[t])
-                    }) {
-                        found.push(k);
+                let mut stack = vec![(q, 0u32)];
+                while let Some((a, b)) = stack.pop() {
+                    let (na, nb) = (&queries.nodes[a as usize], &self.nodes[b as usize]);
+                    if !overlaps(&na.lo, &na.hi, &nb.lo, &nb.hi) {
+                        continue;
                     }
-                });
+                    let extent = |n: &Node| (0..3).map(|d| n.hi[d] - n.lo[d]).sum::<f64>();
+                    match (na.count > 0, nb.count > 0) {
+                        (true, true) => {
+                            let items = &queries.order[na.first as usize..][..na.count as usize];
+                            for &k in &self.order[nb.first as usize..][..nb.count as usize] {
+                                let (lo, hi) = (&self.tri_lo[k as usize], &self.tri_hi[k as usize]);
+                                if items.iter().any(|&t| {
+                                    let t = t as usize;
+                                    overlaps(lo, hi, &queries.tri_lo[t], &queries.tri_hi[t])
+                                }) {
+                                    found.push(k);
+                                }
+                            }
+                        }
+                        (true, false) => stack.extend([(a, nb.first), (a, nb.first + 1)]),
+                        (false, true) => stack.extend([(na.first, b), (na.first + 1, b)]),
+                        (false, false) if extent(na) > extent(nb) => {
+                            stack.extend([(na.first, b), (na.first + 1, b)]);
+                        }
+                        (false, false) => stack.extend([(a, nb.first), (a, nb.first + 1)]),
+                    }
+                }
                 found
             })
             .collect();
