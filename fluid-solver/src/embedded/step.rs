@@ -271,7 +271,6 @@ mod tests {
     use crate::bc::BoundaryCondition;
     use crate::embedded::tests::{cube_mesh, plane, sphere};
     use crate::embedded::tracker::Seed;
-    use crate::embedded::Surface;
     use crate::eos::Eos;
     use crate::mesh::boxmesh::FACE_NAMES;
     use crate::semidiscretization::Numerics;
@@ -312,7 +311,7 @@ mod tests {
             .collect();
         let inside = Seed { point: [0.45, 0.5, 0.5], fluid: false };
         let outside = Seed { point: [0.0; 3], fluid: true };
-        let cases: [(&str, Surface, Tracking, Vec<Seed>, [f64; 3]); 3] = [
+        let cases = [
             (
                 "sphere, Alg. 4.2",
                 sphere([0.45, 0.5, 0.5], 0.25, 6),
