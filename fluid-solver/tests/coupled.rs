@@ -19,7 +19,7 @@ use interface_protocol::handshake::HelloInfo;
 use interface_protocol::io::checkpoint::{tag_for_step, Checkpoint};
 use interface_protocol::liveness::LAUNCHER_PID_ENV;
 use interface_protocol::messages::{
-    reply_kind, scheme_phase, Command, NodeState, Reply, Role, StepHeader, SurfaceElement,
+    reply_kind, scheme_phase, Command, NodeLoad, NodeState, Reply, Role, StepHeader, SurfaceElement,
 };
 use interface_protocol::participant::failure_code;
 use std::path::{Path, PathBuf};
@@ -255,8 +255,8 @@ fn a_coupled_run_without_wet_surface_steps_like_the_fluid_alone() {
 
 /// A wet surface the fluid cannot track is answered `Failed` naming what is wrong, never a panic:
 /// wet nodes without elements and a degenerate element at `Init`; and, after a good step with a
-/// plate across the tube (its loads one per wet node, finite), a non-finite position at the next
-/// `Advance`, naming the node.
+/// plate across the tube (its loads one per wet node, finite) and one with a new topology that adds
+/// a node (loads one per node of the new topology), a non-finite position, naming the node.
 #[test]
 fn an_untrackable_wet_surface_is_answered_failed_naming_element_or_node() {
     let dir = tempfile::tempdir().unwrap();
@@ -316,10 +316,32 @@ fn an_untrackable_wet_surface_is_answered_failed_naming_element_or_node() {
     assert!(loads.iter().all(|l| l.f.iter().all(|c| c.is_finite())), "{loads:?}");
     // The plate holds the gas of the left side (the default seed, the first probe): pushed +x.
     assert!(loads.iter().map(|l| l.f[0]).sum::<f64>() > 0.0, "{loads:?}");
-    let mut bad = at;
-    bad[2].x[1] = f64::NAN;
-    structure.publish_kinematics(header(1, TIMES[2]), 4, |o| o.copy_from_slice(&bad)).unwrap();
+    // A new topology (version 2): the quad as two triangles and a fifth node with a triangle
+    // outside the tube, appended after the others. Read before the kinematics that carry it.
+    let v2 = |step, time| StepHeader { topology_version: 2, ..header(step, time) };
+    let tri = |nodes: [u32; 3]| SurfaceElement {
+        nodes: [nodes[0], nodes[1], nodes[2], 0],
+        n_nodes: 3,
+        phi: [1.0; 4],
+        ..Default::default()
+    };
+    let elements = [tri([0, 1, 2]), tri([0, 2, 3]), tri([1, 4, 2])];
+    structure.publish_topology(v2(1, TIMES[1]), 3, |o| o.copy_from_slice(&elements)).unwrap();
+    let mut at5 = at.to_vec();
+    at5.push(NodeState { x: [0.55, 0.15, 0.0], v: [0.0; 3] });
+    structure.publish_kinematics(v2(1, TIMES[2]), 5, |o| o.copy_from_slice(&at5)).unwrap();
     let command = Command::advance(1, TIMES[1], TIMES[2], scheme_phase::NONE);
+    expect_reply(&mut link, &command, reply_kind::DONE);
+    let (version, loads2) =
+        structure.read_loads(|h, loads| (h.topology_version, loads.to_vec())).unwrap();
+    assert_eq!((version, loads2.len()), (2, 5));
+    assert_eq!(loads2[4].f, [0.0; 3], "the new node's triangle lies outside the tube");
+    let fx = |l: &[NodeLoad]| l.iter().map(|l| l.f[0]).sum::<f64>();
+    assert!(fx(&loads2) > 0.0, "{loads2:?}");
+    let mut bad = at5;
+    bad[2].x[1] = f64::NAN;
+    structure.publish_kinematics(v2(2, TIMES[3]), 5, |o| o.copy_from_slice(&bad)).unwrap();
+    let command = Command::advance(2, TIMES[2], TIMES[3], scheme_phase::NONE);
     let failed = expect_reply(&mut link, &command, reply_kind::FAILED);
     assert_eq!(failed.code, failure_code::PROTOCOL);
     assert!(
