@@ -282,6 +282,56 @@ mod tests {
         ));
     }
 
+    /// States that cannot be tracked are named: a non-finite position or velocity by node, a
+    /// triangle collapsed to a line by its structure element, a wrong count; a new topology over
+    /// appended nodes replaces the triangles and keeps the states.
+    #[test]
+    fn bad_states_and_new_topologies() {
+        let mut s = quad();
+        let (x, v) = (s.x_b.clone(), vec![[0.0; 3]; 4]);
+        assert_eq!(s.check_states(&x, &v), Ok(()));
+        let mut bad = x.clone();
+        bad[3][2] = f64::INFINITY;
+        assert_eq!(
+            s.check_states(&bad, &v),
+            Err(SurfaceError::NonFinite { node: 3, what: "position", value: bad[3] })
+        );
+        let mut w = v.clone();
+        w[1][0] = f64::NAN;
+        assert!(matches!(
+            s.check_states(&x, &w),
+            Err(SurfaceError::NonFinite { node: 1, what: "velocity", .. })
+        ));
+        // Node 3 on the diagonal 0-2: the second triangle (0, 2, 3) has no area.
+        let mut flat = x.clone();
+        flat[3] = [0.5, 0.5, 0.0];
+        assert!(matches!(
+            s.check_states(&flat, &v),
+            Err(SurfaceError::Degenerate { element: 0, corners: [0, 2, 3], .. })
+        ));
+        assert_eq!(
+            s.check_states(&x[..3], &v[..3]),
+            Err(SurfaceError::Count { expected: 4, got: 3 })
+        );
+        s.append_nodes(&[[2.0, 0.0, 0.0]], &[[0.0, 1.0, 0.0]]);
+        let tri =
+            SurfaceElement { nodes: [1, 4, 2, 0], n_nodes: 3, phi: [0.5; 4], ..Default::default() };
+        s.set_topology(&[tri], 2).unwrap();
+        assert_eq!(
+            (s.triangles.clone(), s.phi.clone(), s.topology_version),
+            (vec![[1, 4, 2]], vec![[0.5; 3]], 2)
+        );
+        assert_eq!(
+            (s.x_a[4], s.x_b[4], s.v_b[4]),
+            ([2.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+        );
+        let far = SurfaceElement { nodes: [1, 5, 2, 0], n_nodes: 3, ..Default::default() };
+        assert_eq!(
+            s.set_topology(&[far], 3),
+            Err(SurfaceError::BadNode { element: 0, node: 5, n_nodes: 5 })
+        );
+    }
+
     /// The Hermite path reproduces any cubic motion exactly, and its velocity is the exact
     /// derivative of its position (checked by a central difference).
     #[test]
