@@ -264,6 +264,8 @@ fn track(
         loads: LoadAlgorithm::Reconstructed,
     };
     let mut run = EmbeddedRun::new(prescribed, None, dir)?;
+    // The run's own operator (a run may change the material layout; this one does not).
+    let mut run_semi = semi.clone();
     let mut state = initial.clone();
     let mut ws = Workspace::new(mesh.n_nodes());
     let mut t = 0.0;
@@ -275,7 +277,7 @@ fn track(
         let timed = k > 0;
         let (tracking0, loads0) = (run.tracking_s, run.loads_s);
         let start = Instant::now();
-        let dt = run.step(semi, &mut state, &mut ws, CFL, t, f64::INFINITY)?;
+        let dt = run.step(&mut run_semi, &mut state, &mut ws, CFL, t, f64::INFINITY)?;
         let step_seconds = start.elapsed().as_secs_f64();
         t += dt;
         if timed {
@@ -284,7 +286,7 @@ fn track(
             per_step.entry("loads").or_default().push(run.loads_s - loads0);
         }
         // The same motion, part by part.
-        let (x_b, v_b) = run.prescribed.sample(t);
+        let (x_b, v_b) = run.kinematics.sample(t);
         let was_active = parts.active.clone();
         let mut lap = Instant::now();
         let mut stamp = |name: &str, lap: &mut Instant| {
@@ -323,7 +325,7 @@ fn track(
         stamp("fill", &mut lap);
         parts_step.update(semi, &parts);
         stamp("step_update", &mut lap);
-        let tracker = &run.prescribed.tracker;
+        let tracker = &run.tracker;
         anyhow::ensure!(
             parts.cuts == tracker.cuts && parts.sides == tracker.sides,
             "{} ({:?}), step {k}: the parts disagree with the run's tracker",
@@ -360,7 +362,7 @@ fn track(
             );
         }
     }
-    let tracker = &run.prescribed.tracker;
+    let tracker = &run.tracker;
     let mean = |c: usize| c as f64 / steps as f64;
     let case = TrackingCase {
         name: spec.name,

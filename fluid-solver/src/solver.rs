@@ -154,11 +154,13 @@ impl<'a> FluidRun<'a> {
         }
         let mut ws = Workspace::new(semi.mesh.n_nodes());
         semi.primitives(&state.cons, &mut ws)?;
-        let embedded = match embedded::case::prescribed(case, &semi.mesh, t)? {
+        // Coupled, the surface comes from the structure ([`crate::couple`] embeds it at `Init`).
+        let prescribed = match mode {
+            Mode::Alone => embedded::case::prescribed(case, &semi.mesh, t)?,
+            Mode::Coupled => None,
+        };
+        let embedded = match prescribed {
             None => None,
-            Some(_) if mode == Mode::Coupled => anyhow::bail!(
-                "[fluid.embedded] prescribes the surface of a fluid-alone run; a coupled run takes its surface from the structure"
-            ),
             Some(_) if opts.restart.is_some() => anyhow::bail!(
                 "a run with [fluid.embedded] cannot restart yet: its node status is not in the checkpoints; run it from the start"
             ),
@@ -218,6 +220,31 @@ impl<'a> FluidRun<'a> {
         &self.semi
     }
 
+    /// The primitive states `[ρ, u, v, w, p]` of the last step that computed them (at least the
+    /// start and every step with output).
+    pub fn primitives(&self) -> &[[f64; 5]] {
+        &self.ws.prim
+    }
+
+    /// The output folder.
+    pub fn out_dir(&self) -> &Path {
+        self.out.path()
+    }
+
+    /// Gives the run an embedded surface (a coupled run's, from the structure).
+    pub fn embed(&mut self, surface: EmbeddedRun) {
+        self.embedded = Some(surface);
+    }
+
+    /// The embedded surface, if any.
+    pub fn embedded(&self) -> Option<&EmbeddedRun> {
+        self.embedded.as_ref()
+    }
+
+    pub fn embedded_mut(&mut self) -> Option<&mut EmbeddedRun> {
+        self.embedded.as_mut()
+    }
+
     fn write_probes(&mut self) -> anyhow::Result<()> {
         let prim = &self.ws.prim;
         let row: Vec<f64> = self.probe_nodes.iter().flat_map(|&i| prim[i]).collect();
@@ -274,7 +301,7 @@ impl<'a> FluidRun<'a> {
                 Some(e) => {
                     let (tracking, loads) = (e.tracking_s, e.loads_s);
                     let cfl = self.stepping.cfl();
-                    let r = e.step(&self.semi, &mut self.state, &mut self.ws, cfl, t, stop - t);
+                    let r = e.step(&mut self.semi, &mut self.state, &mut self.ws, cfl, t, stop);
                     let d = |s: f64| std::time::Duration::from_secs_f64(s.max(0.0));
                     self.timers.add(bucket::TRACKING, d(e.tracking_s - tracking));
                     self.timers.add(bucket::LOADS, d(e.loads_s - loads));

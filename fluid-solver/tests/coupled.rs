@@ -1,17 +1,16 @@
-//! `fluid-solver run --couple`: the fluid as a protocol participant. Without an embedded boundary
-//! (thesis Ch. 4-5) it couples only to a structure without a wet surface: such a run advances the
-//! fluid over the coupling steps exactly as the stand-alone stepper does with the same targets,
-//! and a structure with a wet surface is refused at `Init` with a message naming the reason.
+//! `fluid-solver run --couple`: the fluid as a protocol participant. Coupled to a structure
+//! without a wet surface, it advances the fluid over the coupling steps exactly as the
+//! stand-alone stepper does with the same targets; a wet surface it cannot track is answered
+//! `Failed` naming the element or node. (`cases/shell-water-air`, `tests/shell_water_air.rs`,
+//! couples a wet surface through `fsi`.)
 //!
-//! `rigid-structure` requires at least one wet node, so the structure without a wet surface is
-//! played here by the test itself, which is also the launcher. The refusal runs through `fsi`;
-//! build the binaries first: `cargo build --release -p coupler-scripts -p rigid-structure -p
-//! fluid-solver --bins`.
+//! `rigid-structure` requires at least one wet node and checks its own states, so the structure
+//! here is played by the test itself, which is also the launcher. Build the binaries first:
+//! `cargo build --release -p coupler-scripts -p rigid-structure -p fluid-solver --bins`.
 
 mod common;
 
 use common::ExactTube;
-use fluid_solver::couple::no_embedded_boundary;
 use fluid_solver::eos::Eos;
 use fluid_solver::solver::{FluidRun, Mode, RunOptions};
 use interface_protocol::case::Case;
@@ -19,7 +18,9 @@ use interface_protocol::endpoint::{LauncherLink, StructureEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
 use interface_protocol::io::checkpoint::{tag_for_step, Checkpoint};
 use interface_protocol::liveness::LAUNCHER_PID_ENV;
-use interface_protocol::messages::{reply_kind, scheme_phase, Command, Reply, Role, StepHeader};
+use interface_protocol::messages::{
+    reply_kind, scheme_phase, Command, NodeLoad, NodeState, Reply, Role, StepHeader, SurfaceElement,
+};
 use interface_protocol::participant::failure_code;
 use std::path::{Path, PathBuf};
 use std::process::{Command as Process, Stdio};
@@ -73,18 +74,6 @@ t_end = 0.1
 [output]
 fields_every = 10
 probes_every = 1
-"#;
-
-/// A rigid piston with a wet square of four nodes.
-const WET_STRUCTURE: &str = r#"
-[structure]
-command = ["rigid-structure"]
-
-[structure.rigid]
-mass = 1.0
-stiffness = 1.0e4
-wet_nodes = [[0.0, -0.1, -0.1], [0.0, 0.1, -0.1], [0.0, 0.1, 0.1], [0.0, -0.1, 0.1]]
-wet_elements = [[0, 1, 2, 3]]
 "#;
 
 /// The coupling times t^n of `FLUID`.
@@ -264,27 +253,107 @@ fn a_coupled_run_without_wet_surface_steps_like_the_fluid_alone() {
     assert!(err < 0.02, "mean density error along the line {err}");
 }
 
+/// A wet surface the fluid cannot track is answered `Failed` naming what is wrong, never a panic:
+/// wet nodes without elements and a degenerate element at `Init`; and, after a good step with a
+/// plate across the tube (its loads one per wet node, finite) and one with a new topology that adds
+/// a node (loads one per node of the new topology), a non-finite position, naming the node.
 #[test]
-fn a_structure_with_a_wet_surface_is_refused_at_init() {
+fn an_untrackable_wet_surface_is_answered_failed_naming_element_or_node() {
     let dir = tempfile::tempdir().unwrap();
-    let case_path = write_case(dir.path(), &format!("{FLUID}{WET_STRUCTURE}"));
-    let out = dir.path().join("run");
-    let start = Instant::now();
-    let r = Process::new(bin("fsi"))
-        .arg("run")
-        .arg(&case_path)
-        .arg("--out")
-        .arg(&out)
-        .arg("--quiet")
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    let elapsed = start.elapsed();
-    let stderr = String::from_utf8_lossy(&r.stderr);
-    assert!(!r.status.success(), "fsi succeeded: {stderr}");
-    assert!(elapsed < Duration::from_secs(10), "took {elapsed:?}: {stderr}");
-    assert!(stderr.contains(&no_embedded_boundary(4)), "{stderr}");
-    assert!(out.join("run.json").is_file());
+    let case_path = write_case(dir.path(), FLUID);
+    let case = Case::load(&case_path, &[]).unwrap();
+    let plate = |x: f64| {
+        [[x, -0.1, -0.1], [x, 0.1, -0.1], [x, 0.1, 0.1], [x, -0.1, 0.1]]
+            .map(|x| NodeState { x, v: [0.0; 3] })
+    };
+    let quad =
+        SurfaceElement { nodes: [0, 1, 2, 3], n_nodes: 4, phi: [1.0; 4], ..Default::default() };
+    let init_failure = |tag: &str, elements: Vec<SurfaceElement>, nodes: Vec<NodeState>| {
+        let out = dir.path().join(tag);
+        std::fs::create_dir(&out).unwrap();
+        let (mut link, fluid, mut structure) = start_coupled(&case_path, &case, &out, tag);
+        structure
+            .publish_topology(header(0, 0.0), elements.len(), |o| o.copy_from_slice(&elements))
+            .unwrap();
+        structure
+            .publish_kinematics(header(0, 0.0), nodes.len(), |o| o.copy_from_slice(&nodes))
+            .unwrap();
+        let failed = expect_reply(&mut link, &Command::init(), reply_kind::FAILED);
+        expect_reply(&mut link, &Command::finish(), reply_kind::DONE);
+        fluid.wait_with_output().unwrap();
+        drop(structure);
+        link.remove_resources().unwrap();
+        (failed.code, failed.message_str().to_string())
+    };
+    let (code, message) = init_failure("nodes-only", Vec::new(), plate(0.55).to_vec());
+    assert_eq!(code, failure_code::UNSUPPORTED);
+    assert!(message.contains("4 wet nodes and 0 wet elements"), "{message}");
+    let mut flat = plate(0.55);
+    flat[2].x = flat[1].x;
+    let sliver =
+        SurfaceElement { nodes: [0, 1, 2, 0], n_nodes: 3, phi: [1.0; 4], ..Default::default() };
+    let (code, message) = init_failure("degenerate", vec![quad, sliver], flat.to_vec());
+    assert_eq!(code, failure_code::PROTOCOL);
+    assert!(
+        message.contains("surface element 0 (its triangle [0, 1, 2]) is degenerate"),
+        "{message}"
+    );
+
+    let out = dir.path().join("nan");
+    std::fs::create_dir(&out).unwrap();
+    let (mut link, fluid, mut structure) = start_coupled(&case_path, &case, &out, "nan");
+    structure.publish_topology(header(0, 0.0), 1, |o| o[0] = quad).unwrap();
+    let at = plate(0.55);
+    structure.publish_kinematics(header(0, 0.0), 4, |o| o.copy_from_slice(&at)).unwrap();
+    expect_reply(&mut link, &Command::init(), reply_kind::READY);
+    let n0 = structure.read_loads(|_, loads| loads.len()).unwrap();
+    assert_eq!(n0, 4, "one load per wet node at the start");
+    structure.publish_kinematics(header(0, TIMES[1]), 4, |o| o.copy_from_slice(&at)).unwrap();
+    let command = Command::advance(0, TIMES[0], TIMES[1], scheme_phase::NONE);
+    expect_reply(&mut link, &command, reply_kind::DONE);
+    let (t, loads) = structure.read_loads(|h, loads| (h.time, loads.to_vec())).unwrap();
+    assert_eq!((t, loads.len()), (TIMES[1], 4));
+    assert!(loads.iter().all(|l| l.f.iter().all(|c| c.is_finite())), "{loads:?}");
+    // The plate holds the gas of the left side (the default seed, the first probe): pushed +x.
+    assert!(loads.iter().map(|l| l.f[0]).sum::<f64>() > 0.0, "{loads:?}");
+    // A new topology (version 2): the quad as two triangles and a fifth node with a triangle
+    // outside the tube, appended after the others. Read before the kinematics that carry it.
+    let v2 = |step, time| StepHeader { topology_version: 2, ..header(step, time) };
+    let tri = |nodes: [u32; 3]| SurfaceElement {
+        nodes: [nodes[0], nodes[1], nodes[2], 0],
+        n_nodes: 3,
+        phi: [1.0; 4],
+        ..Default::default()
+    };
+    let elements = [tri([0, 1, 2]), tri([0, 2, 3]), tri([1, 4, 2])];
+    structure.publish_topology(v2(1, TIMES[1]), 3, |o| o.copy_from_slice(&elements)).unwrap();
+    let mut at5 = at.to_vec();
+    at5.push(NodeState { x: [0.55, 0.15, 0.0], v: [0.0; 3] });
+    structure.publish_kinematics(v2(1, TIMES[2]), 5, |o| o.copy_from_slice(&at5)).unwrap();
+    let command = Command::advance(1, TIMES[1], TIMES[2], scheme_phase::NONE);
+    expect_reply(&mut link, &command, reply_kind::DONE);
+    let (version, loads2) =
+        structure.read_loads(|h, loads| (h.topology_version, loads.to_vec())).unwrap();
+    assert_eq!((version, loads2.len()), (2, 5));
+    assert_eq!(loads2[4].f, [0.0; 3], "the new node's triangle lies outside the tube");
+    let fx = |l: &[NodeLoad]| l.iter().map(|l| l.f[0]).sum::<f64>();
+    assert!(fx(&loads2) > 0.0, "{loads2:?}");
+    let mut bad = at5;
+    bad[2].x[1] = f64::NAN;
+    structure.publish_kinematics(v2(2, TIMES[3]), 5, |o| o.copy_from_slice(&bad)).unwrap();
+    let command = Command::advance(2, TIMES[2], TIMES[3], scheme_phase::NONE);
+    let failed = expect_reply(&mut link, &command, reply_kind::FAILED);
+    assert_eq!(failed.code, failure_code::PROTOCOL);
+    assert!(
+        failed.message_str().contains("surface node 2 has a non-finite position [0.55, NaN, 0.1]"),
+        "{}",
+        failed.message_str()
+    );
+    expect_reply(&mut link, &Command::finish(), reply_kind::DONE);
+    let out = fluid.wait_with_output().unwrap();
+    assert!(out.status.success(), "fluid-solver: {}", String::from_utf8_lossy(&out.stderr));
+    drop(structure);
+    link.remove_resources().unwrap();
 }
 
 /// A coupled fluid checks its state every step as the fluid alone does: two streams leaving each

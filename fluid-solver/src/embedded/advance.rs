@@ -1,24 +1,68 @@
-//! One fluid step with a prescribed embedded surface (DESIGN §5.1, "Each step"): the CFL step over
-//! the active nodes, limited so that no surface node moves more than one fluid edge (thesis §4.4)
-//! -> the surface at `t_b` -> tracking -> the uncovered nodes filled -> the two RK2 stages with the
+//! One fluid step with an embedded surface (DESIGN §5.1, "Each step"): the CFL step over the
+//! active nodes, limited so that no surface node moves more than one fluid edge (thesis §4.4)
+//! -> the surface at `t_b` from its [`Kinematics`] -> tracking -> the nodes that changed side take
+//! their new side's fluid ([`super::side_fluid`]) and are filled -> the two RK2 stages with the
 //! walls -> `p*` and the nodal loads at `t_b` (Alg. 5.3 or 5.4), whose resultant force and moment
 //! go to `surface_forces.csv`.
+//!
+//! The surface moves the same way whoever prescribes it: a fluid-alone run samples its motion
+//! law at the end of every step; a coupled run samples the cubic Hermite path (DESIGN §4) between
+//! the structure's `(x, v)` at the start of the coupling step (the fluid's own copy) and the
+//! published `(x, v)` at its end, so the fluid subcycles inside the coupling step in its own CFL
+//! steps and the last one lands on the published state exactly.
 
-use super::case::Prescribed;
+use super::case::{sample, Prescribed};
 use super::fill::fill_changed;
 use super::loads::{nodal_loads, LoadView};
+use super::motion::RigidMotion;
+use super::side_fluid::side_materials;
 use super::step::{EmbeddedStep, Wall};
+use super::surface::HermitePath;
+use super::tracker::Tracker;
 use crate::mesh::geometry::{cross, norm};
 use crate::semidiscretization::Semidiscretization;
 use crate::state::{State, Workspace};
 use crate::time::cfl::stable_time_step;
 use crate::time::rk2::rk2_step_embedded;
+use interface_protocol::case::LoadAlgorithm;
 use interface_protocol::io::probes::ProbeWriter;
 use std::path::Path;
 
-/// The embedded surface of a fluid-alone run and what it reports.
+/// Where the surface's nodal states at the end of each fluid step come from.
+#[derive(Debug, Clone)]
+pub enum Kinematics {
+    /// `[fluid.embedded] motion` (fluid-alone runs): `x(t) = motion(reference, t)`, exact at any
+    /// time; no motion keeps the surface at rest at `reference`.
+    Law { motion: Option<RigidMotion>, reference: Vec<[f64; 3]> },
+    /// The structure over the protocol (coupled runs): the Hermite path from `(x_from, v_from)`
+    /// at `path.t_a` to `(x_to, v_to)` at `path.t_b`, one coupling step.
+    Coupled {
+        path: HermitePath,
+        x_from: Vec<[f64; 3]>,
+        v_from: Vec<[f64; 3]>,
+        x_to: Vec<[f64; 3]>,
+        v_to: Vec<[f64; 3]>,
+    },
+}
+
+impl Kinematics {
+    /// Nodal positions and velocities at `t`.
+    pub fn sample(&self, t: f64) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        match self {
+            Kinematics::Law { motion, reference } => sample(motion.as_ref(), reference, t),
+            Kinematics::Coupled { path, x_from, v_from, x_to, v_to } => {
+                (0..x_to.len()).map(|n| path.at(t, x_from[n], v_from[n], x_to[n], v_to[n])).unzip()
+            }
+        }
+    }
+}
+
+/// The embedded surface of a run and what it reports.
 pub struct EmbeddedRun {
-    pub prescribed: Prescribed,
+    pub tracker: Tracker,
+    pub kinematics: Kinematics,
+    /// Alg. 5.3 or 5.4.
+    pub load_algorithm: LoadAlgorithm,
     /// Cavitation cut-off of the case (`None`: each EOS's default).
     pub p_cut: Option<f64>,
     /// Nodal loads at the end of the last step, in surface node order.
@@ -28,46 +72,62 @@ pub struct EmbeddedRun {
     /// Seconds spent tracking (refit, intersect, sides, fill) and in the loads.
     pub tracking_s: f64,
     pub loads_s: f64,
+    forces: ProbeWriter,
     /// The last step's view of the boundary, updated from step to step.
     step: Option<EmbeddedStep>,
-    forces: ProbeWriter,
 }
 
 impl EmbeddedRun {
-    /// Opens `surface_forces.csv` in `dir` (`time,surface.fx,...,surface.mz`: the resultant of the
-    /// nodal loads on the structure and its moment about the origin).
+    /// The surface of `[fluid.embedded]` with its prescribed motion; opens `surface_forces.csv`
+    /// in `dir`.
     pub fn new(prescribed: Prescribed, p_cut: Option<f64>, dir: &Path) -> anyhow::Result<Self> {
+        let Prescribed { tracker, motion, reference, loads } = prescribed;
+        EmbeddedRun::with(tracker, Kinematics::Law { motion, reference }, loads, p_cut, dir)
+    }
+
+    /// A surface moved by `kinematics`, its loads by `load_algorithm`; opens
+    /// `surface_forces.csv` in `dir` (`time,surface.fx,...,surface.mz`: the resultant of the
+    /// nodal loads on the structure and its moment about the origin).
+    pub fn with(
+        tracker: Tracker,
+        kinematics: Kinematics,
+        load_algorithm: LoadAlgorithm,
+        p_cut: Option<f64>,
+        dir: &Path,
+    ) -> anyhow::Result<Self> {
         let forces = ProbeWriter::create(
             &dir.join("surface_forces.csv"),
             &["surface"],
             &["fx", "fy", "fz", "mx", "my", "mz"],
         )?;
-        let loads = vec![[0.0; 3]; prescribed.tracker.surface.n_nodes()];
+        let loads = vec![[0.0; 3]; tracker.surface.n_nodes()];
         Ok(EmbeddedRun {
-            prescribed,
+            tracker,
+            kinematics,
+            load_algorithm,
             p_cut,
             loads,
             clips: 0,
             tracking_s: 0.0,
             loads_s: 0.0,
-            step: None,
             forces,
+            step: None,
         })
     }
 
-    /// One step from `t` of at most `dt_max` at Courant number `cfl`; returns the step taken.
+    /// One step from `t` at Courant number `cfl` that does not pass `stop` (a step that reaches
+    /// it ends on it exactly); returns the step taken.
     pub fn step(
         &mut self,
-        semi: &Semidiscretization,
+        semi: &mut Semidiscretization,
         state: &mut State,
         ws: &mut Workspace,
         cfl: f64,
         t: f64,
-        dt_max: f64,
+        stop: f64,
     ) -> anyhow::Result<f64> {
-        let mesh = &semi.mesh;
         stable_time_step(semi, &state.cons, ws)?;
-        let tracker = &self.prescribed.tracker;
+        let tracker = &self.tracker;
         let dt_cfl = ws
             .dt_node
             .iter()
@@ -80,20 +140,37 @@ impl EmbeddedRun {
         let h = tracker.adjacency.h_min.iter().copied().fold(f64::INFINITY, f64::min);
         let speed = tracker.surface.v_b.iter().map(|v| norm(*v)).fold(0.0, f64::max);
         let dt_surface = if speed > 0.0 { 0.5 * h / speed } else { f64::INFINITY };
-        let dt = (cfl * dt_cfl).min(dt_surface).min(dt_max);
-        // Tracking: from the surface at t + dt to the step's view (the CFL step is the fluid's).
+        let dt = (cfl * dt_cfl).min(dt_surface).min(stop - t);
+        let t_b = if dt >= stop - t { stop } else { t + dt };
+        // Tracking: from the surface at t_b to the step's view (the CFL step is the fluid's).
         let start = std::time::Instant::now();
-        let (x, v) = self.prescribed.sample(t + dt);
+        let (x, v) = self.kinematics.sample(t_b);
         let was_active = tracker.active.clone();
-        let tracker = &mut self.prescribed.tracker;
-        let changes = tracker.advance(mesh, t + dt, &x, &v)?;
-        let cut = tracker.cuts.cut_mask(mesh.n_edges());
-        let material = semi.material();
-        let filled = fill_changed(
-            mesh,
+        let tracker = &mut self.tracker;
+        let changes = tracker.advance(&semi.mesh, t_b, &x, &v)?;
+        let cut = tracker.cuts.cut_mask(semi.mesh.n_edges());
+        let sides = &tracker.sides;
+        let changed_fluid = side_materials(
+            &semi.mesh,
             &tracker.adjacency,
             &changes,
-            &tracker.sides,
+            sides,
+            &was_active,
+            &cut,
+            semi.material(),
+        );
+        if let Some(material) = changed_fluid {
+            semi.set_materials(material.clone())?;
+            state.material = material;
+            // Nodes that changed fluid change the mask of uncut edges too: a new view.
+            self.step = None;
+        }
+        let material = semi.material();
+        let filled = fill_changed(
+            &semi.mesh,
+            &tracker.adjacency,
+            &changes,
+            sides,
             &was_active,
             &cut,
             &ws.prim,
@@ -104,30 +181,26 @@ impl EmbeddedRun {
             state.cons[i] = semi.eos_at(i).prim_to_cons(&w);
             ws.prim[i] = w;
         }
-        let step = match &mut self.step {
-            Some(step) => {
+        let semi = &*semi;
+        // The view is updated in place (bitwise a new one); a failed step leaves none behind.
+        let step = match self.step.take() {
+            Some(mut step) => {
                 step.update(semi, tracker);
                 step
             }
-            None => self.step.insert(EmbeddedStep::new(semi, tracker, self.p_cut)),
+            None => EmbeddedStep::new(semi, tracker, self.p_cut),
         };
         self.tracking_s += start.elapsed().as_secs_f64();
-        rk2_step_embedded(semi, state, ws, dt, step, tracker)?;
+        rk2_step_embedded(semi, state, ws, dt, &step, tracker)?;
         let start = std::time::Instant::now();
         semi.primitives(&state.cons, ws)?;
-        let wall = Wall { step, tracker, t: t + dt };
-        let (p_star, clips) = wall.pressures(semi, &ws.prim)?;
-        self.clips += clips as u64;
-        let view = LoadView {
-            mesh,
-            surface: &tracker.surface,
-            t: t + dt,
-            side: &tracker.sides.side,
-            cuts: &tracker.cuts.cuts,
-            p_star: &p_star,
-        };
-        nodal_loads(self.prescribed.loads, &view, &mut self.loads)?;
-        self.prescribed.tracker.p_star = p_star;
+        self.wall_pressures(semi, &step, &ws.prim)?;
+        self.step = Some(step);
+        let mut loads = std::mem::take(&mut self.loads);
+        // A new topology may add surface nodes.
+        loads.resize(self.tracker.surface.n_nodes(), [0.0; 3]);
+        self.write_loads(semi, &mut loads)?;
+        self.loads = loads;
         let (mut f, mut m) = ([0.0; 3], [0.0; 3]);
         for (load, x) in self.loads.iter().zip(&x) {
             let r = cross(*x, *load);
@@ -136,9 +209,54 @@ impl EmbeddedRun {
                 m[k] += r[k];
             }
         }
-        self.forces.write_row(t + dt, &[f[0], f[1], f[2], m[0], m[1], m[2]])?;
+        self.forces.write_row(t_b, &[f[0], f[1], f[2], m[0], m[1], m[2]])?;
         self.loads_s += start.elapsed().as_secs_f64();
         Ok(dt)
+    }
+
+    /// `p*` at every cut edge from the primitive states `prim` at the surface's current time
+    /// (`t_b`), kept in the tracker for the loads; counts the cavitation clips.
+    fn wall_pressures(
+        &mut self,
+        semi: &Semidiscretization,
+        step: &EmbeddedStep,
+        prim: &[[f64; 5]],
+    ) -> anyhow::Result<()> {
+        let wall = Wall { step, tracker: &self.tracker, t: self.tracker.surface.t_b };
+        let (p_star, clips) = wall.pressures(semi, prim)?;
+        self.clips += clips as u64;
+        self.tracker.p_star = p_star;
+        Ok(())
+    }
+
+    /// `p*` at the current state, before any step (the coupled run's load at `Init`).
+    pub fn start_pressures(
+        &mut self,
+        semi: &Semidiscretization,
+        prim: &[[f64; 5]],
+    ) -> anyhow::Result<()> {
+        let step = EmbeddedStep::new(semi, &self.tracker, self.p_cut);
+        self.wall_pressures(semi, &step, prim)
+    }
+
+    /// The nodal loads on the structure (Alg. 5.3 or 5.4, both sides of a shell summed) at the
+    /// surface's current time from the last `p*`, written into `out` in surface node order (the
+    /// protocol's order in a coupled run).
+    pub fn write_loads(
+        &self,
+        semi: &Semidiscretization,
+        out: &mut [[f64; 3]],
+    ) -> anyhow::Result<()> {
+        let tracker = &self.tracker;
+        let view = LoadView {
+            mesh: &semi.mesh,
+            surface: &tracker.surface,
+            t: tracker.surface.t_b,
+            side: &tracker.sides.side,
+            cuts: &tracker.cuts.cuts,
+            p_star: &tracker.p_star,
+        };
+        Ok(nodal_loads(self.load_algorithm, &view, out)?)
     }
 
     pub fn flush(&mut self) -> anyhow::Result<()> {

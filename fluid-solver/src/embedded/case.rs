@@ -1,14 +1,19 @@
-//! `[fluid.embedded]` to a tracker (fluid-alone runs): the surface from its file or generator,
-//! its prescribed motion, the tracking algorithm and the flood-fill seeds, with errors naming the
-//! field. Without seeds the fluid is every node reached from the mesh node nearest to the first
-//! probe, or else from the mesh's first node.
+//! `[fluid.embedded]` to a tracker, with errors naming the field.
+//! - Fluid-alone runs ([`prescribed`]): the surface from its file or generator, its prescribed
+//!   motion, the tracking algorithm, the loads algorithm and the flood-fill seeds.
+//! - Coupled runs ([`from_structure`]): the surface comes from the structure over the protocol;
+//!   `tracking`, `loads`, `seeds` and `p_cut` apply, `surface` and `motion` are refused. Without
+//!   the section the defaults apply (Alg. 4.2, Alg. 5.3, the default seed).
+//!
+//! Without seeds the fluid is every node reached from the mesh node nearest to the first probe,
+//! or else from the mesh's first node.
 
 use super::generate::{generate, SurfaceMesh};
 use super::motion::RigidMotion;
 use super::tracker::{Seed, Tracker};
 use super::Surface;
 use crate::mesh::Mesh;
-use interface_protocol::case::{Case, EmbeddedSurface, FluidEmbedded, LoadAlgorithm};
+use interface_protocol::case::{Case, EmbeddedSurface, FluidEmbedded, LoadAlgorithm, Tracking};
 
 /// An embedded surface with its prescribed motion, ready to step.
 #[derive(Debug, Clone)]
@@ -21,29 +26,53 @@ pub struct Prescribed {
     pub loads: LoadAlgorithm,
 }
 
-impl Prescribed {
-    /// Positions and velocities of the surface nodes at `t`.
-    pub fn sample(&self, t: f64) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
-        sample(self.motion.as_ref(), &self.reference, t)
-    }
+/// A surface from the structure, tracked as the case says.
+#[derive(Debug, Clone)]
+pub struct FromStructure {
+    pub tracker: Tracker,
+    pub loads: LoadAlgorithm,
+    /// Cavitation cut-off (`None`: each EOS's default).
+    pub p_cut: Option<f64>,
 }
 
 fn field_error(case: &Case, field: &str, message: impl std::fmt::Display) -> anyhow::Error {
     case.field_error(field, message.to_string()).into()
 }
 
-/// The surface mesh of `[fluid.embedded] surface`.
+fn section(case: &Case) -> Option<&FluidEmbedded> {
+    case.fluid.as_ref().and_then(|f| f.embedded.as_ref())
+}
+
+/// The surface mesh of `[fluid.embedded] surface` (required in fluid-alone runs).
 pub fn surface_mesh(case: &Case, e: &FluidEmbedded) -> anyhow::Result<SurfaceMesh> {
     match &e.surface {
-        EmbeddedSurface::Generated { generator } => Ok(generate(generator)),
-        EmbeddedSurface::File { file } => super::read::read(&case.dir().join(file))
+        None => Err(field_error(
+            case,
+            "fluid.embedded.surface",
+            "a fluid-alone run needs the surface: { file = \"surface.msh\" } or a generator \
+             (plate, box, sphere, cylinder)",
+        )),
+        Some(EmbeddedSurface::Generated { generator }) => Ok(generate(generator)),
+        Some(EmbeddedSurface::File { file }) => super::read::read(&case.dir().join(file))
             .map_err(|err| field_error(case, "fluid.embedded.surface.file", err)),
     }
 }
 
+/// The flood-fill seeds of the case: `[fluid.embedded] seeds`, or the default.
+fn seeds(case: &Case, e: Option<&FluidEmbedded>, mesh: &Mesh) -> Vec<Seed> {
+    let mut seeds: Vec<Seed> = e
+        .map(|e| e.seeds.iter().map(|s| Seed { point: s.at, fluid: s.active }).collect())
+        .unwrap_or_default();
+    if seeds.is_empty() {
+        let first_probe = case.fluid.as_ref().and_then(|f| f.probes.first());
+        seeds.push(Seed { point: first_probe.map_or(mesh.coords[0], |p| p.at), fluid: true });
+    }
+    seeds
+}
+
 /// The tracker of `[fluid.embedded]` on `mesh` at `t0`, or `None` without that section.
 pub fn prescribed(case: &Case, mesh: &Mesh, t0: f64) -> anyhow::Result<Option<Prescribed>> {
-    let Some(e) = case.fluid.as_ref().and_then(|f| f.embedded.as_ref()) else {
+    let Some(e) = section(case) else {
         return Ok(None);
     };
     let s = surface_mesh(case, e)?;
@@ -56,19 +85,44 @@ pub fn prescribed(case: &Case, mesh: &Mesh, t0: f64) -> anyhow::Result<Option<Pr
     surface.v_b = v;
     surface.t_a = t0;
     surface.t_b = t0;
-    let mut seeds: Vec<Seed> =
-        e.seeds.iter().map(|s| Seed { point: s.at, fluid: s.active }).collect();
-    if seeds.is_empty() {
-        let first_probe = case.fluid.as_ref().and_then(|f| f.probes.first());
-        seeds.push(Seed { point: first_probe.map_or(mesh.coords[0], |p| p.at), fluid: true });
-    }
-    let tracker = Tracker::new(mesh, surface, e.tracking, &seeds)
+    let tracker = Tracker::new(mesh, surface, e.tracking, &seeds(case, Some(e), mesh))
         .map_err(|err| field_error(case, "fluid.embedded.seeds", err))?;
     Ok(Some(Prescribed { tracker, motion, reference: s.x, loads: e.loads }))
 }
 
+/// Refuses the keys of `[fluid.embedded]` that only a fluid-alone run reads.
+pub fn check_coupled(case: &Case) -> anyhow::Result<()> {
+    let Some(e) = section(case) else {
+        return Ok(());
+    };
+    let why = "a coupled run takes the surface and its motion from the structure over the \
+               protocol; remove this key (it applies to fluid-alone runs)";
+    if e.surface.is_some() {
+        return Err(field_error(case, "fluid.embedded.surface", why));
+    }
+    if e.motion.is_some() {
+        return Err(field_error(case, "fluid.embedded.motion", why));
+    }
+    Ok(())
+}
+
+/// The tracker of a surface the structure sent, at rest at `surface.t_b` with the velocities it
+/// holds, with the case's tracking, loads, seeds and cut-off.
+pub fn from_structure(case: &Case, mesh: &Mesh, surface: Surface) -> anyhow::Result<FromStructure> {
+    check_coupled(case)?;
+    let e = section(case);
+    let tracking = e.map_or(Tracking::default(), |e| e.tracking);
+    let tracker = Tracker::new(mesh, surface, tracking, &seeds(case, e, mesh))
+        .map_err(|err| field_error(case, "fluid.embedded.seeds", err))?;
+    Ok(FromStructure {
+        tracker,
+        loads: e.map_or(LoadAlgorithm::default(), |e| e.loads),
+        p_cut: e.and_then(|e| e.p_cut),
+    })
+}
+
 /// Positions and velocities at `t` of the points whose positions at `t = 0` are `reference`.
-fn sample(
+pub(crate) fn sample(
     motion: Option<&RigidMotion>,
     reference: &[[f64; 3]],
     t: f64,

@@ -20,6 +20,7 @@ pub mod motion;
 pub mod predicates;
 pub mod read;
 pub mod riemann_fs;
+pub mod side_fluid;
 pub mod status;
 pub mod step;
 pub mod surface;

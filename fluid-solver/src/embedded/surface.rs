@@ -6,6 +6,7 @@
 //! `(x_b, v_b)` (DESIGN §4): the wall velocity at any stage time is the exact time derivative of
 //! the wall position, so a rigid translation moves no mass through the surface.
 
+use crate::mesh::geometry::{cross, dot, sub};
 use interface_protocol::messages::SurfaceElement;
 
 /// The surface of one step.
@@ -41,7 +42,22 @@ pub enum SurfaceError {
     BadNode { element: usize, node: u32, n_nodes: usize },
     #[error("surface element {element} has a non-finite phi {phi:?}")]
     BadPhi { element: usize, phi: [f64; 4] },
+    #[error("surface node {node} has a non-finite {what} {value:?}")]
+    NonFinite { node: usize, what: &'static str, value: [f64; 3] },
+    #[error(
+        "surface element {element} (its triangle {corners:?}) is degenerate: area {area:e} m² \
+         for a longest edge of {edge:e} m"
+    )]
+    Degenerate { element: u32, corners: [u32; 3], area: f64, edge: f64 },
+    #[error("{got} nodal states for a surface of {expected} nodes")]
+    Count { expected: usize, got: usize },
 }
+
+/// A triangle whose area is below this fraction of its longest edge squared has no usable normal.
+pub const DEGENERATE_AREA: f64 = 1e-12;
+
+/// The triangles of `elements` over `n_nodes` nodes: quads split, the map back, phi per corner.
+type Triangulation = (Vec<[u32; 3]>, Vec<u32>, Vec<[f64; 3]>);
 
 impl Surface {
     /// A surface at rest at `x` (positions at both ends equal, velocities zero) from elements, for
@@ -52,28 +68,7 @@ impl Surface {
         version: u64,
     ) -> Result<Surface, SurfaceError> {
         let n_nodes = x.len();
-        let mut triangles = Vec::with_capacity(elements.len() * 2);
-        let mut element_of = Vec::with_capacity(elements.len() * 2);
-        let mut phi = Vec::with_capacity(elements.len() * 2);
-        for (k, e) in elements.iter().enumerate() {
-            let n = e.n_nodes as usize;
-            if n != 3 && n != 4 {
-                return Err(SurfaceError::NodeCount { element: k, n: e.n_nodes });
-            }
-            if let Some(&node) = e.nodes[..n].iter().find(|&&v| v as usize >= n_nodes) {
-                return Err(SurfaceError::BadNode { element: k, node, n_nodes });
-            }
-            if e.phi[..n].iter().any(|p| !p.is_finite()) {
-                return Err(SurfaceError::BadPhi { element: k, phi: e.phi });
-            }
-            let corners: &[[usize; 3]] =
-                if n == 3 { &[[0, 1, 2]] } else { &[[0, 1, 2], [0, 2, 3]] };
-            for c in corners {
-                triangles.push(c.map(|m| e.nodes[m]));
-                element_of.push(k as u32);
-                phi.push(c.map(|m| e.phi[m]));
-            }
-        }
+        let (triangles, element_of, phi) = triangulate(elements, n_nodes)?;
         let zero = vec![[0.0; 3]; n_nodes];
         Ok(Surface {
             triangles,
@@ -87,6 +82,59 @@ impl Surface {
             x_b: x,
             v_b: zero,
         })
+    }
+
+    /// A new topology `version` (after a crack): the triangles of `elements` over the nodes there
+    /// are now. The nodal states are kept; nodes the new topology adds are appended first with
+    /// [`Surface::append_nodes`].
+    pub fn set_topology(
+        &mut self,
+        elements: &[SurfaceElement],
+        version: u64,
+    ) -> Result<(), SurfaceError> {
+        (self.triangles, self.element_of, self.phi) = triangulate(elements, self.n_nodes())?;
+        self.topology_version = version;
+        Ok(())
+    }
+
+    /// Appends nodes at rest at `x` with velocity `v` at both ends of the step (the phantom nodes
+    /// of a crack start where the structure first publishes them).
+    pub fn append_nodes(&mut self, x: &[[f64; 3]], v: &[[f64; 3]]) {
+        self.x_a.extend_from_slice(x);
+        self.x_b.extend_from_slice(x);
+        self.v_a.extend_from_slice(v);
+        self.v_b.extend_from_slice(v);
+    }
+
+    /// Checks nodal states `(x, v)` for this surface before it moves there: one per node, finite,
+    /// and no triangle degenerate at `x` (area below [`DEGENERATE_AREA`] of its longest edge
+    /// squared), each failure naming the node or the structure element.
+    pub fn check_states(&self, x: &[[f64; 3]], v: &[[f64; 3]]) -> Result<(), SurfaceError> {
+        let n = self.n_nodes();
+        if x.len() != n || v.len() != n {
+            return Err(SurfaceError::Count { expected: n, got: x.len().min(v.len()) });
+        }
+        for (what, values) in [("position", x), ("velocity", v)] {
+            if let Some(node) = values.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                return Err(SurfaceError::NonFinite { node, what, value: values[node] });
+            }
+        }
+        for (t, corners) in self.triangles.iter().enumerate() {
+            let [a, b, c] = corners.map(|k| x[k as usize]);
+            let (ab, ac, bc) = (sub(b, a), sub(c, a), sub(c, b));
+            let edge = [ab, ac, bc].map(|e| dot(e, e)).into_iter().fold(0.0, f64::max);
+            let n = cross(ab, ac);
+            let twice_area = dot(n, n).sqrt();
+            if !(twice_area > 2.0 * DEGENERATE_AREA * edge) {
+                return Err(SurfaceError::Degenerate {
+                    element: self.element_of[t],
+                    corners: *corners,
+                    area: 0.5 * twice_area,
+                    edge: edge.sqrt(),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Number of surface nodes.
@@ -109,24 +157,8 @@ impl Surface {
     /// `t_a` and `t_b` exactly the end states. A step of zero length returns the end state.
     #[inline]
     pub fn node_at(&self, n: usize, t: f64) -> ([f64; 3], [f64; 3]) {
-        let h = self.t_b - self.t_a;
-        if h <= 0.0 {
-            return (self.x_b[n], self.v_b[n]);
-        }
-        let s = ((t - self.t_a) / h).clamp(0.0, 1.0);
-        let (s2, s3) = (s * s, s * s * s);
-        let (h00, h10, h01, h11) =
-            (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s, 3.0 * s2 - 2.0 * s3, s3 - s2);
-        let (d00, d10, d01, d11) =
-            (6.0 * (s2 - s), 3.0 * s2 - 4.0 * s + 1.0, 6.0 * (s - s2), 3.0 * s2 - 2.0 * s);
-        let (xa, va, xb, vb) = (self.x_a[n], self.v_a[n], self.x_b[n], self.v_b[n]);
-        let mut x = [0.0; 3];
-        let mut v = [0.0; 3];
-        for k in 0..3 {
-            x[k] = h00 * xa[k] + h10 * h * va[k] + h01 * xb[k] + h11 * h * vb[k];
-            v[k] = (d00 * xa[k] + d01 * xb[k]) / h + d10 * va[k] + d11 * vb[k];
-        }
-        (x, v)
+        let path = HermitePath { t_a: self.t_a, t_b: self.t_b };
+        path.at(t, self.x_a[n], self.v_a[n], self.x_b[n], self.v_b[n])
     }
 
     /// Corners and corner velocities of triangle `tri` at time `t`.
@@ -151,6 +183,73 @@ impl Surface {
             }
         }
         (px, pv)
+    }
+}
+
+/// Splits `elements` into triangles over `n_nodes` nodes, checking node counts, indices and phi.
+fn triangulate(elements: &[SurfaceElement], n_nodes: usize) -> Result<Triangulation, SurfaceError> {
+    let mut triangles = Vec::with_capacity(elements.len() * 2);
+    let mut element_of = Vec::with_capacity(elements.len() * 2);
+    let mut phi = Vec::with_capacity(elements.len() * 2);
+    for (k, e) in elements.iter().enumerate() {
+        let n = e.n_nodes as usize;
+        if n != 3 && n != 4 {
+            return Err(SurfaceError::NodeCount { element: k, n: e.n_nodes });
+        }
+        if let Some(&node) = e.nodes[..n].iter().find(|&&v| v as usize >= n_nodes) {
+            return Err(SurfaceError::BadNode { element: k, node, n_nodes });
+        }
+        if e.phi[..n].iter().any(|p| !p.is_finite()) {
+            return Err(SurfaceError::BadPhi { element: k, phi: e.phi });
+        }
+        let corners: &[[usize; 3]] = if n == 3 { &[[0, 1, 2]] } else { &[[0, 1, 2], [0, 2, 3]] };
+        for c in corners {
+            triangles.push(c.map(|m| e.nodes[m]));
+            element_of.push(k as u32);
+            phi.push(c.map(|m| e.phi[m]));
+        }
+    }
+    Ok((triangles, element_of, phi))
+}
+
+/// The cubic Hermite path over `[t_a, t_b]` (DESIGN §4): the cubic through `(x_a, v_a)` at `t_a`
+/// and `(x_b, v_b)` at `t_b`, its velocity the exact derivative of its position. The surface's
+/// path inside a fluid step, and the path of the structure's kinematics inside a coupling step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HermitePath {
+    pub t_a: f64,
+    pub t_b: f64,
+}
+
+impl HermitePath {
+    /// Position and velocity at `t` (clamped to `[t_a, t_b]`): exactly the end states at `t_a` and
+    /// `t_b`; the end state on a path of zero length.
+    #[inline]
+    pub fn at(
+        &self,
+        t: f64,
+        xa: [f64; 3],
+        va: [f64; 3],
+        xb: [f64; 3],
+        vb: [f64; 3],
+    ) -> ([f64; 3], [f64; 3]) {
+        let h = self.t_b - self.t_a;
+        if h <= 0.0 {
+            return (xb, vb);
+        }
+        let s = ((t - self.t_a) / h).clamp(0.0, 1.0);
+        let (s2, s3) = (s * s, s * s * s);
+        let (h00, h10, h01, h11) =
+            (2.0 * s3 - 3.0 * s2 + 1.0, s3 - 2.0 * s2 + s, 3.0 * s2 - 2.0 * s3, s3 - s2);
+        let (d00, d10, d01, d11) =
+            (6.0 * (s2 - s), 3.0 * s2 - 4.0 * s + 1.0, 6.0 * (s - s2), 3.0 * s2 - 2.0 * s);
+        let mut x = [0.0; 3];
+        let mut v = [0.0; 3];
+        for k in 0..3 {
+            x[k] = h00 * xa[k] + h10 * h * va[k] + h01 * xb[k] + h11 * h * vb[k];
+            v[k] = (d00 * xa[k] + d01 * xb[k]) / h + d10 * va[k] + d11 * vb[k];
+        }
+        (x, v)
     }
 }
 
@@ -181,6 +280,56 @@ mod tests {
             Surface::new(&[e], vec![[0.0; 3]; 3], 0),
             Err(SurfaceError::NodeCount { .. })
         ));
+    }
+
+    /// States that cannot be tracked are named: a non-finite position or velocity by node, a
+    /// triangle collapsed to a line by its structure element, a wrong count; a new topology over
+    /// appended nodes replaces the triangles and keeps the states.
+    #[test]
+    fn bad_states_and_new_topologies() {
+        let mut s = quad();
+        let (x, v) = (s.x_b.clone(), vec![[0.0; 3]; 4]);
+        assert_eq!(s.check_states(&x, &v), Ok(()));
+        let mut bad = x.clone();
+        bad[3][2] = f64::INFINITY;
+        assert_eq!(
+            s.check_states(&bad, &v),
+            Err(SurfaceError::NonFinite { node: 3, what: "position", value: bad[3] })
+        );
+        let mut w = v.clone();
+        w[1][0] = f64::NAN;
+        assert!(matches!(
+            s.check_states(&x, &w),
+            Err(SurfaceError::NonFinite { node: 1, what: "velocity", .. })
+        ));
+        // Node 3 on the diagonal 0-2: the second triangle (0, 2, 3) has no area.
+        let mut flat = x.clone();
+        flat[3] = [0.5, 0.5, 0.0];
+        assert!(matches!(
+            s.check_states(&flat, &v),
+            Err(SurfaceError::Degenerate { element: 0, corners: [0, 2, 3], .. })
+        ));
+        assert_eq!(
+            s.check_states(&x[..3], &v[..3]),
+            Err(SurfaceError::Count { expected: 4, got: 3 })
+        );
+        s.append_nodes(&[[2.0, 0.0, 0.0]], &[[0.0, 1.0, 0.0]]);
+        let tri =
+            SurfaceElement { nodes: [1, 4, 2, 0], n_nodes: 3, phi: [0.5; 4], ..Default::default() };
+        s.set_topology(&[tri], 2).unwrap();
+        assert_eq!(
+            (s.triangles.clone(), s.phi.clone(), s.topology_version),
+            (vec![[1, 4, 2]], vec![[0.5; 3]], 2)
+        );
+        assert_eq!(
+            (s.x_a[4], s.x_b[4], s.v_b[4]),
+            ([2.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+        );
+        let far = SurfaceElement { nodes: [1, 5, 2, 0], n_nodes: 3, ..Default::default() };
+        assert_eq!(
+            s.set_topology(&[far], 3),
+            Err(SurfaceError::BadNode { element: 0, node: 5, n_nodes: 5 })
+        );
     }
 
     /// The Hermite path reproduces any cubic motion exactly, and its velocity is the exact

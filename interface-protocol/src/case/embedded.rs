@@ -1,6 +1,10 @@
-//! `[fluid.embedded]`: a structure surface embedded in the fluid grid for fluid-alone runs (thesis
-//! Ch. 4-5): its geometry (a gmsh surface mesh or a generator), a prescribed rigid motion, the
-//! tracking and loads algorithms, and the seeds of the node-status flood fill.
+//! `[fluid.embedded]`: a structure surface embedded in the fluid grid (thesis Ch. 4-5): its
+//! geometry (a gmsh surface mesh or a generator), a prescribed rigid motion, the tracking and
+//! loads algorithms, and the seeds of the node-status flood fill.
+//!
+//! A fluid-alone run needs `surface` and may give `motion`. A coupled run takes the surface and
+//! its motion from the structure over the protocol: there `surface` and `motion` do not apply
+//! (`fluid-solver` refuses them), and `tracking`, `loads`, `seeds` and `p_cut` do.
 //!
 //! ```toml
 //! [fluid.embedded]
@@ -28,7 +32,10 @@ use serde::Deserialize;
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FluidEmbedded {
-    pub surface: EmbeddedSurface,
+    /// The surface of a fluid-alone run; a coupled run takes it from the structure over the
+    /// protocol and refuses this key (and `motion`).
+    #[serde(default)]
+    pub surface: Option<EmbeddedSurface>,
     #[serde(default)]
     pub motion: Option<Motion>,
     #[serde(default)]
@@ -189,7 +196,7 @@ impl FluidEmbedded {
                 None => Ok(()),
             }
         };
-        if let EmbeddedSurface::Generated { generator } = &self.surface {
+        if let Some(EmbeddedSurface::Generated { generator }) = &self.surface {
             match *generator {
                 SurfaceGenerator::Sphere { center, radius, refinement } => {
                     finite("surface.center", &center)?;
@@ -322,13 +329,13 @@ mod tests {
             embedded("surface = { generator = \"sphere\", center = [0, 0, 0], radius = 0.5 }\n");
         assert_eq!(
             e.surface,
-            EmbeddedSurface::Generated {
+            Some(EmbeddedSurface::Generated {
                 generator: SurfaceGenerator::Sphere {
                     center: [0.0; 3],
                     radius: 0.5,
                     refinement: 3
                 }
-            }
+            })
         );
         assert_eq!(
             (e.tracking, e.loads, e.motion),
@@ -339,7 +346,7 @@ mod tests {
              motion = { kind = \"harmonic\", amplitude = [0.08, 0, 0], frequency = 100 }\n\
              seeds = [{ at = [0, 0, 0], active = false }]\n",
         );
-        assert_eq!(e.surface, EmbeddedSurface::File { file: "plate.msh".into() });
+        assert_eq!(e.surface, Some(EmbeddedSurface::File { file: "plate.msh".into() }));
         assert_eq!(e.loads, LoadAlgorithm::Facets);
         assert_eq!(
             e.motion,
