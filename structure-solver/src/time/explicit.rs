@@ -59,6 +59,17 @@ impl CentralDifference {
         }
     }
 
+    /// Follows a change of `model`'s topology made after the last step (nodes appended,
+    /// whose motion `state` holds already: `Dynamics::push_nodes`, `Dynamics::copy_nodes`):
+    /// the work arrays grow to the model's dofs.
+    pub fn follow_topology(&mut self, model: &dyn Model) -> Result<(), super::ResizeError> {
+        let n = self.state.fits(model)?;
+        for w in [&mut self.v_half, &mut self.fi, &mut self.r, &mut self.du, &mut self.scratch] {
+            w.resize(n, 0.0);
+        }
+        Ok(())
+    }
+
     fn update_acceleration(&mut self, model: &mut dyn Model, t: f64, extra: Option<&[f64]>) {
         out_of_balance(model, t, extra, &mut self.fi, &mut self.r);
         model.apply_inverse_mass(&self.r, &mut self.state.a);

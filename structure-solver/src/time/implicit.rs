@@ -130,6 +130,27 @@ impl Implicit {
         }
     }
 
+    /// Follows a change of `model`'s topology made after the last step (nodes appended,
+    /// whose motion `state` holds already: `Dynamics::push_nodes`, `Dynamics::copy_nodes`):
+    /// the work arrays grow to the model's dofs and the solver takes the new free-dof
+    /// numbering.
+    pub fn follow_topology(&mut self, model: &dyn Model) -> Result<(), super::ResizeError> {
+        let n = self.state.fits(model)?;
+        for w in [
+            &mut self.fi,
+            &mut self.r,
+            &mut self.du,
+            &mut self.delta,
+            &mut self.scratch,
+            &mut self.acc,
+            &mut self.inertia,
+        ] {
+            w.resize(n, 0.0);
+        }
+        self.solver.sync(model);
+        Ok(())
+    }
+
     /// `false`: factor the Jacobian at every Newton iteration instead of reusing the last
     /// factor as the GMRES preconditioner (the reference the reuse is checked against).
     pub fn set_factor_reuse(&mut self, reuse: bool) {
