@@ -97,8 +97,12 @@ impl FeModel {
             let same = nodes_of(c).iter().map(|&n| n as usize).eq(self.cells[c].iter().copied());
             if rec.element_ids[c] != self.topology.elements.ids()[c] || !same {
                 return bad(format!(
-                    "element slot {c} (id {}) differs from the model's (a checkpoint of another mesh?)",
-                    rec.element_ids[c]
+                    "element slot {c}: id {} on nodes {:?}, the model's id {} on nodes {:?} (a \
+                     checkpoint of another mesh?)",
+                    rec.element_ids[c],
+                    nodes_of(c),
+                    self.topology.elements.ids()[c],
+                    self.cells[c]
                 ));
             }
         }

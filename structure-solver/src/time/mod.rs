@@ -62,7 +62,8 @@ impl Dynamics {
     }
 
     /// Appends nodes that start with the velocity and acceleration of the nodes `sources`
-    /// (phantom nodes start with the motion of the nodes they copy).
+    /// (phantom nodes start with the motion of the nodes they copy; the integrators'
+    /// `follow_topology` then gives them the acceleration of the changed model).
     pub fn copy_nodes(&mut self, sources: &[usize]) -> Result<(), ResizeError> {
         let n = self.v.len() / 6;
         if let Some(&node) = sources.iter().find(|&&s| s >= n) {
@@ -75,7 +76,7 @@ impl Dynamics {
         Ok(())
     }
 
-    /// The state fits `model` after its topology changed.
+    /// The state fits `model` after its topology changed; returns its dofs.
     fn fits(&self, model: &dyn Model) -> Result<usize, ResizeError> {
         let n = model.n_dof();
         if self.v.len() != n || self.a.len() != n {
@@ -83,6 +84,24 @@ impl Dynamics {
         }
         Ok(n)
     }
+}
+
+/// Accelerations `M⁻¹ (f_ext(t) + extra - f_int)` of the changed model at its committed
+/// configuration written into `a` for the dofs from `first` on (the nodes a topology change
+/// added; the others keep theirs, so a change that does not touch them leaves their motion
+/// as it was). The trial state the evaluation leaves is dropped.
+fn added_accelerations(
+    model: &mut dyn Model,
+    (t, extra): (f64, Option<&[f64]>),
+    first: usize,
+    work: [&mut [f64]; 3],
+    a: &mut [f64],
+) {
+    let [fi, r, all] = work;
+    out_of_balance(model, t, extra, fi, r);
+    model.apply_inverse_mass(r, all);
+    a[first..].copy_from_slice(&all[first..]);
+    model.revert();
 }
 
 /// Prescribed increments of the constrained dofs over `[t, t + dt]` written into `du`.
