@@ -5,13 +5,16 @@
 //! The state of an `FeModel`: positions `x`, nodal rotation matrices `rotations`, accumulated
 //! spins `spins` (BT4 shells read their increments from them), the J2 state of every element
 //! `material`, and for BT4 shells per point the stresses, equivalent plastic strain and
-//! hourglass stresses (`bt4.*`). A restart restores all of it, so it reproduces the run
-//! bitwise.
+//! hourglass stresses (`bt4.*`), and the topology (`topology.*`: version, node and element
+//! ids, reference positions, the user's fixed dofs, and the element list with the element
+//! each was copied from), so that a restart after a change at run time first rebuilds the
+//! changed model from the one its case builds. A restart restores all of it, so it
+//! reproduces the run bitwise.
 
 use interface_protocol::io::checkpoint::Checkpoint;
 use nalgebra::{Matrix3, Vector3};
 
-use crate::assembly::FeModel;
+use crate::assembly::{FeModel, TopologyRecord};
 use crate::elements::bt4::Bt4State;
 use crate::model::Model;
 use crate::time::Dynamics;
@@ -40,8 +43,51 @@ fn vectors(a: &[f64]) -> Vec<Vector3<f64>> {
     a.chunks_exact(3).map(Vector3::from_column_slice).collect()
 }
 
-/// Puts the committed configuration and element state of `model` into `ck`.
+/// The arrays of a [`TopologyRecord`].
+const TOPOLOGY: &str = "topology.node_ids";
+
+fn save_topology(model: &FeModel, ck: &mut Checkpoint) -> anyhow::Result<()> {
+    let t = model.topology_record();
+    ck.put("topology.version", vec![t.version])?;
+    ck.put(TOPOLOGY, t.node_ids)?;
+    ck.put("topology.x0", t.x0)?;
+    ck.put("topology.fixed", t.fixed.iter().map(|&f| f as u8).collect::<Vec<u8>>())?;
+    ck.put("topology.element_ids", t.element_ids)?;
+    ck.put("topology.element_source", t.element_source)?;
+    ck.put("topology.element_offsets", t.element_offsets)?;
+    ck.put("topology.element_nodes", t.element_nodes)?;
+    Ok(())
+}
+
+/// The topology record of `ck`, if it holds one (checkpoints written before topology
+/// changes existed hold none: the model as built).
+fn load_topology(ck: &Checkpoint) -> anyhow::Result<Option<TopologyRecord>> {
+    if !ck.names().any(|n| n == TOPOLOGY) {
+        return Ok(None);
+    }
+    let version = match ck.u64("topology.version")? {
+        [v] => *v,
+        v => anyhow::bail!(
+            "checkpoint at step {}: array `topology.version` holds {} values, expected 1",
+            ck.step,
+            v.len()
+        ),
+    };
+    Ok(Some(TopologyRecord {
+        version,
+        node_ids: ck.u64(TOPOLOGY)?.to_vec(),
+        x0: ck.f64("topology.x0")?.to_vec(),
+        fixed: ck.u8("topology.fixed")?.iter().map(|&f| f != 0).collect(),
+        element_ids: ck.u64("topology.element_ids")?.to_vec(),
+        element_source: ck.u64("topology.element_source")?.to_vec(),
+        element_offsets: ck.u64("topology.element_offsets")?.to_vec(),
+        element_nodes: ck.u64("topology.element_nodes")?.to_vec(),
+    }))
+}
+
+/// Puts the topology, committed configuration and element state of `model` into `ck`.
 pub fn save_state(model: &FeModel, ck: &mut Checkpoint) -> anyhow::Result<()> {
+    save_topology(model, ck)?;
     ck.put("x", flat(model.positions()))?;
     let r: Vec<f64> = model.rotations().iter().flat_map(|m| m.as_slice().to_vec()).collect();
     ck.put("rotations", r)?;
@@ -58,8 +104,14 @@ pub fn save_state(model: &FeModel, ck: &mut Checkpoint) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Restores what [`save_state`] wrote into `model` and commits it.
+/// Restores what [`save_state`] wrote into `model` (the model its case builds) and commits
+/// it: the topology first, then the state of the changed model.
 pub fn restore_state(model: &mut FeModel, ck: &Checkpoint) -> anyhow::Result<()> {
+    if let Some(t) = load_topology(ck)? {
+        model
+            .rebuild_topology(&t)
+            .map_err(|e| anyhow::anyhow!("checkpoint at step {}: {e}", ck.step))?;
+    }
     let n = model.n_nodes();
     let x = vectors(sized(ck, "x", 3 * n)?);
     let r: Vec<Matrix3<f64>> =

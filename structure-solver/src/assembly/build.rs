@@ -115,6 +115,7 @@ impl FeModel {
             spin_sum: vec![Vector3::zeros(); nn],
             material: vec![0.0; state_offsets[elements.len()]],
         };
+        let topology = super::topology::Topology::built(nn, mesh.cells.len(), &element_cell);
         let mut m = FeModel {
             x0,
             trial: state.clone(),
@@ -145,6 +146,7 @@ impl FeModel {
             held_extra: vec![],
             scratch: vec![],
             element_bound: vec![],
+            topology,
         };
         m.set_rotary_inertia(RotaryInertia::Physical);
         Ok(m)

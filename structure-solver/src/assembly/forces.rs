@@ -265,6 +265,11 @@ impl Model for FeModel {
         self.bt4.is_none()
     }
 
+    /// The topology version (`topology`): 1 as built, increased by every run-time change.
+    fn topology_epoch(&self) -> u64 {
+        self.topology.version
+    }
+
     fn stable_dt(&self) -> f64 {
         self.current_stable_dt()
     }

@@ -22,6 +22,10 @@
 //! integrator uses the `Model` hooks for the master's mass block and free rigid-body drift.
 //! A master at a point or at the mass centre is a node appended after the mesh nodes.
 //!
+//! Topology (`topology`: user ids apart from slots, the version; `topology_change`: nodes
+//! added and elements duplicated with their state at run time; `topology_record`: what a
+//! checkpoint holds of it, and the rebuild of a changed model at a restart).
+//!
 //! Parts: elastic shells, J2 shells integrated through the thickness (MITC4, DKT), beams,
 //! tets, and the explicit-only one-point BT4 shells, which have no tangent (static and
 //! implicit solvers return an error for a model holding them).
@@ -34,6 +38,9 @@ mod loads;
 mod rigid_bodies;
 mod stable_step;
 mod state;
+mod topology;
+mod topology_change;
+mod topology_record;
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -46,6 +53,9 @@ use crate::rigid::RigidBody;
 
 use constraints::SkewNode;
 pub use loads::Curve;
+pub use topology::{IdMap, Store, Topology, TopologyError};
+pub use topology_change::NewNode;
+pub use topology_record::TopologyRecord;
 
 /// What a mesh cell becomes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -141,6 +151,8 @@ pub struct FeModel {
     scratch: Vec<element_forces::ElementScratch>,
     /// Each element's bound of the critical step at the reference configuration.
     element_bound: Vec<stable_step::ElementBound>,
+    /// User ids of nodes and cells, where each cell's element is stored, the version.
+    topology: topology::Topology,
 }
 
 /// The BT4 shells of a model with their work arrays.

@@ -69,7 +69,7 @@ impl FeModel {
         }
         let body = RigidBody::new(master, slaves, &x, &r, &extra, &node_mass)?;
         if let Some(p) = point {
-            self.add_node(p);
+            self.add_node(self.topology.nodes.next_id(), p);
         }
         let id = self.rigid.len();
         self.body_of[master] = Some(id);
@@ -88,8 +88,9 @@ impl FeModel {
         Ok(master)
     }
 
-    /// Appends a node at `p` (no element, six free dofs, no mass of its own).
-    pub(super) fn add_node(&mut self, p: Vector3<f64>) {
+    /// Appends node `id` (a free id) at `p` (no element, six free dofs, no mass of its own).
+    pub(super) fn add_node(&mut self, id: u64, p: Vector3<f64>) {
+        self.topology.nodes.push(id).expect("a free node id");
         self.x0.push(p);
         for s in [&mut self.trial, &mut self.committed] {
             s.x.push(p);

@@ -59,6 +59,25 @@ impl CentralDifference {
         }
     }
 
+    /// Follows a change of `model`'s topology made after the last step, nodes appended
+    /// whose velocity `state` holds already (`Dynamics::push_nodes`, `Dynamics::copy_nodes`):
+    /// the work arrays grow to the model's dofs and the new dofs take the acceleration of the
+    /// changed model at the current time (with `extra`); the others keep theirs.
+    pub fn follow_topology(
+        &mut self,
+        model: &mut dyn Model,
+        extra: Option<&[f64]>,
+    ) -> Result<(), super::ResizeError> {
+        let n = self.state.fits(model)?;
+        let first = self.fi.len();
+        for w in [&mut self.v_half, &mut self.fi, &mut self.r, &mut self.du, &mut self.scratch] {
+            w.resize(n, 0.0);
+        }
+        let work = [&mut self.fi[..], &mut self.r[..], &mut self.scratch[..]];
+        super::added_accelerations(model, (self.state.t, extra), first, work, &mut self.state.a);
+        Ok(())
+    }
+
     fn update_acceleration(&mut self, model: &mut dyn Model, t: f64, extra: Option<&[f64]>) {
         out_of_balance(model, t, extra, &mut self.fi, &mut self.r);
         model.apply_inverse_mass(&self.r, &mut self.state.a);

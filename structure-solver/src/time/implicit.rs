@@ -130,6 +130,35 @@ impl Implicit {
         }
     }
 
+    /// Follows a change of `model`'s topology made after the last step, nodes appended
+    /// whose velocity `state` holds already (`Dynamics::push_nodes`, `Dynamics::copy_nodes`):
+    /// the work arrays grow to the model's dofs, the new dofs take the acceleration of the
+    /// changed model at the current time (with `extra`; the others keep theirs) and the
+    /// solver takes the new free-dof numbering.
+    pub fn follow_topology(
+        &mut self,
+        model: &mut dyn Model,
+        extra: Option<&[f64]>,
+    ) -> Result<(), super::ResizeError> {
+        let n = self.state.fits(model)?;
+        let first = self.fi.len();
+        for w in [
+            &mut self.fi,
+            &mut self.r,
+            &mut self.du,
+            &mut self.delta,
+            &mut self.scratch,
+            &mut self.acc,
+            &mut self.inertia,
+        ] {
+            w.resize(n, 0.0);
+        }
+        let work = [&mut self.fi[..], &mut self.r[..], &mut self.scratch[..]];
+        super::added_accelerations(model, (self.state.t, extra), first, work, &mut self.state.a);
+        self.solver.sync(model);
+        Ok(())
+    }
+
     /// `false`: factor the Jacobian at every Newton iteration instead of reusing the last
     /// factor as the GMRES preconditioner (the reference the reuse is checked against).
     pub fn set_factor_reuse(&mut self, reuse: bool) {

@@ -15,6 +15,7 @@ pub mod implicit;
 
 pub use critical::{critical_dt, CriticalDt, StableStep};
 pub use explicit::CentralDifference;
+
 pub use implicit::{Implicit, ImplicitError, ImplicitScheme, NewtonParams, StepInfo};
 
 use crate::model::Model;
@@ -25,6 +26,82 @@ pub struct Dynamics {
     pub t: f64,
     pub v: Vec<f64>,
     pub a: Vec<f64>,
+}
+
+/// The integrator's dofs cannot follow a change of its model's topology.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ResizeError {
+    #[error("{what}: {got} values, expected 6 per added node ({expected})")]
+    Length { what: &'static str, got: usize, expected: usize },
+    #[error("node {node} to copy the motion of is past the {n} nodes of the integrator")]
+    Source { node: usize, n: usize },
+    #[error("the model has {model} dofs, the integrator's state {state}: add the new nodes' motion first")]
+    Dofs { model: usize, state: usize },
+}
+
+impl Dynamics {
+    /// Appends nodes with velocities `v` and accelerations `a`, 6 per node.
+    pub fn push_nodes(&mut self, v: &[f64], a: &[f64]) -> Result<(), ResizeError> {
+        if v.len() % 6 != 0 {
+            return Err(ResizeError::Length {
+                what: "velocity",
+                got: v.len(),
+                expected: v.len().div_ceil(6) * 6,
+            });
+        }
+        if a.len() != v.len() {
+            return Err(ResizeError::Length {
+                what: "acceleration",
+                got: a.len(),
+                expected: v.len(),
+            });
+        }
+        self.v.extend_from_slice(v);
+        self.a.extend_from_slice(a);
+        Ok(())
+    }
+
+    /// Appends nodes that start with the velocity and acceleration of the nodes `sources`
+    /// (phantom nodes start with the motion of the nodes they copy; the integrators'
+    /// `follow_topology` then gives them the acceleration of the changed model).
+    pub fn copy_nodes(&mut self, sources: &[usize]) -> Result<(), ResizeError> {
+        let n = self.v.len() / 6;
+        if let Some(&node) = sources.iter().find(|&&s| s >= n) {
+            return Err(ResizeError::Source { node, n });
+        }
+        for &s in sources {
+            self.v.extend_from_within(6 * s..6 * s + 6);
+            self.a.extend_from_within(6 * s..6 * s + 6);
+        }
+        Ok(())
+    }
+
+    /// The state fits `model` after its topology changed; returns its dofs.
+    fn fits(&self, model: &dyn Model) -> Result<usize, ResizeError> {
+        let n = model.n_dof();
+        if self.v.len() != n || self.a.len() != n {
+            return Err(ResizeError::Dofs { model: n, state: self.v.len() });
+        }
+        Ok(n)
+    }
+}
+
+/// Accelerations `M⁻¹ (f_ext(t) + extra - f_int)` of the changed model at its committed
+/// configuration written into `a` for the dofs from `first` on (the nodes a topology change
+/// added; the others keep theirs, so a change that does not touch them leaves their motion
+/// as it was). The trial state the evaluation leaves is dropped.
+fn added_accelerations(
+    model: &mut dyn Model,
+    (t, extra): (f64, Option<&[f64]>),
+    first: usize,
+    work: [&mut [f64]; 3],
+    a: &mut [f64],
+) {
+    let [fi, r, all] = work;
+    out_of_balance(model, t, extra, fi, r);
+    model.apply_inverse_mass(r, all);
+    a[first..].copy_from_slice(&all[first..]);
+    model.revert();
 }
 
 /// Prescribed increments of the constrained dofs over `[t, t + dt]` written into `du`.

@@ -225,6 +225,51 @@ impl Bt4 {
         self.committed.alpha[((e / LANES) * np + p) * LANES + e % LANES]
     }
 
+    /// Appends a copy of element `e` on the nodes `conn` with its thickness, material and
+    /// full committed state (stresses, equivalent plastic strain and hourglass stresses at
+    /// every point, copied into the trial state too): a phantom element of the phantom-node
+    /// formulation (thesis §3.5, Fig. 3.2). A new block of zero state is opened when the last
+    /// one is full; the node incidence is rebuilt at the next force. Returns the new
+    /// element's index, or `None` when `e` is not an element of the part.
+    pub fn push_copy(&mut self, e: usize, conn: [u32; 4]) -> Option<usize> {
+        if e >= self.conn.len() {
+            return None;
+        }
+        let new = self.conn.len();
+        let (thickness, material) = (self.thickness[e], self.material_of[e]);
+        self.conn.push(conn);
+        self.thickness.push(thickness);
+        self.material_of.push(material);
+        let np = self.settings.rule.len();
+        let nb = self.conn.len().div_ceil(LANES);
+        for s in [&mut self.committed, &mut self.trial] {
+            s.stress.resize(nb * np * N_STRESS * LANES, 0.0);
+            s.alpha.resize(nb * np * LANES, 0.0);
+            s.hourglass.resize(nb * N_HOURGLASS * LANES, 0.0);
+        }
+        let lane = |e: usize, rows: usize, r: usize| ((e / LANES) * rows + r) * LANES + e % LANES;
+        let c = &mut self.committed;
+        for r in 0..np * N_STRESS {
+            c.stress[lane(new, np * N_STRESS, r)] = c.stress[lane(e, np * N_STRESS, r)];
+        }
+        for r in 0..np {
+            c.alpha[lane(new, np, r)] = c.alpha[lane(e, np, r)];
+        }
+        for r in 0..N_HOURGLASS {
+            c.hourglass[lane(new, N_HOURGLASS, r)] = c.hourglass[lane(e, N_HOURGLASS, r)];
+        }
+        self.trial.clone_from(&self.committed);
+        self.work = forces::Work::default();
+        Some(new)
+    }
+
+    /// Committed hourglass stresses of element `e` (membrane x, y, out-of-plane, rotations x,
+    /// y).
+    pub fn hourglass(&self, e: usize) -> [f64; N_HOURGLASS] {
+        let (b, l) = (e / LANES, e % LANES);
+        std::array::from_fn(|m| self.committed.hourglass[(b * N_HOURGLASS + m) * LANES + l])
+    }
+
     /// Bytes of state and work arrays per element (double-buffered state, connectivity,
     /// thickness, material index, element forces, node incidence).
     pub fn bytes_per_element(&self) -> f64 {
