@@ -194,6 +194,7 @@ fn two_material_row(mesh: Mesh, steps: usize, threads: &[usize]) -> anyhow::Resu
             .map(|&m| semi.eos[m as usize].prim_to_cons(&rest[m as usize]))
             .collect(),
         material: semi.material().to_vec(),
+        phi: Vec::new(),
     };
     let (measurements, mut split) = measure(&semi, &state, steps, threads, |_| Ok(()))?;
     let per_node = 1.0 / semi.mesh.n_nodes() as f64;

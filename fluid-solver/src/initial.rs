@@ -85,6 +85,7 @@ impl InitialCondition {
         Ok(State {
             cons: fills.iter().map(|f| eos[f.material as usize].prim_to_cons(&f.state)).collect(),
             material: fills.iter().map(|f| f.material).collect(),
+            phi: Vec::new(),
         })
     }
 }

@@ -4,7 +4,8 @@
 //!
 //! Modules follow the discretisation: `eos` -> `mesh` (geometry and connectivity only, never
 //! solver state) -> `riemann`, `flux`, `reconstruct`, `bc` -> `state`, `initial` ->
-//! `special_edges`, `two_phase` -> `semidiscretization` (the residual) -> `time` -> `setup`
+//! `special_edges`, `two_phase` -> `semidiscretization` (the residual, its `error`s) -> `time` ->
+//! `levelset` (the moving interface between two fluids) -> `setup`
 //! (everything before the first step, with `memory`) -> `solver` (the run loop) with `output`,
 //! `probes` -> `couple` (the coupling participant) and `check` (`fluid-solver check`). Must not touch: the structure, the IPC
 //! transport (it talks to the structure only through `interface-protocol` endpoints).
@@ -17,8 +18,10 @@ pub mod check;
 pub mod couple;
 pub mod embedded;
 pub mod eos;
+pub mod error;
 pub mod flux;
 pub mod initial;
+pub mod levelset;
 pub mod memory;
 pub mod mesh;
 pub mod output;

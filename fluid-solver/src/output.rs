@@ -37,13 +37,15 @@ pub fn create_writer(dir: &Path, mesh: &Mesh) -> Result<TimeSeriesWriter, xdmf::
     TimeSeriesWriter::create(dir, "fluid", &xdmf::Mesh { points: &mesh.coords, blocks: &blocks })
 }
 
-/// Writes one time step of the primitive fields, the Mach number (each node's own sound speed)
-/// and the material id of each node (`material`, as a scalar).
+/// Writes one time step of the primitive fields, the Mach number (each node's own sound speed),
+/// the material id of each node (`material`, as a scalar) and, when the run has one, the level
+/// set `phi` (empty: none).
 pub fn write_fields(
     writer: &mut TimeSeriesWriter,
     semi: &Semidiscretization,
     time: f64,
     prim: &[[f64; 5]],
+    phi: &[f64],
 ) -> Result<(), xdmf::XdmfError> {
     let rho: Vec<f64> = prim.iter().map(|w| w[0]).collect();
     let p: Vec<f64> = prim.iter().map(|w| w[4]).collect();
@@ -57,14 +59,15 @@ pub fn write_fields(
         })
         .collect();
     let material: Vec<f64> = semi.material().iter().map(|&m| f64::from(m)).collect();
-    writer.write_step(
-        time,
-        &[
-            Field { name: "rho", location: Location::Node, values: Values::Scalar(&rho) },
-            Field { name: "velocity", location: Location::Node, values: Values::Vector(&v) },
-            Field { name: "p", location: Location::Node, values: Values::Scalar(&p) },
-            Field { name: "mach", location: Location::Node, values: Values::Scalar(&mach) },
-            Field { name: "material", location: Location::Node, values: Values::Scalar(&material) },
-        ],
-    )
+    let mut fields = vec![
+        Field { name: "rho", location: Location::Node, values: Values::Scalar(&rho) },
+        Field { name: "velocity", location: Location::Node, values: Values::Vector(&v) },
+        Field { name: "p", location: Location::Node, values: Values::Scalar(&p) },
+        Field { name: "mach", location: Location::Node, values: Values::Scalar(&mach) },
+        Field { name: "material", location: Location::Node, values: Values::Scalar(&material) },
+    ];
+    if !phi.is_empty() {
+        fields.push(Field { name: "phi", location: Location::Node, values: Values::Scalar(phi) });
+    }
+    writer.write_step(time, &fields)
 }

@@ -34,9 +34,11 @@
 //!   touching an owned node, the update over owned nodes only, and a ghost exchange precedes each
 //!   stage.
 
+pub use crate::error::FluidError;
+
 use crate::bc::BoundaryCondition;
 use crate::embedded::step::Wall;
-use crate::eos::{Eos, StateError};
+use crate::eos::Eos;
 use crate::flux::{numerical_flux, FluxScheme};
 use crate::mesh::blocks::Window;
 use crate::mesh::geometry::{dot, sub};
@@ -44,7 +46,6 @@ use crate::mesh::{Mesh, MeshError};
 use crate::reconstruct::gradient::{LsqGradient, MirrorPlanes};
 use crate::reconstruct::limiter::Limiter;
 use crate::reconstruct::muscl;
-use crate::riemann::RiemannError;
 use crate::special_edges::{SpecialEdges, SpecialKind};
 use crate::state::{MaterialId, Workspace};
 use rayon::prelude::*;
@@ -66,30 +67,6 @@ impl Numerics {
     pub fn second_order(&self) -> bool {
         self.limiter != Limiter::FirstOrder
     }
-}
-
-/// A failure of a residual evaluation, naming the node.
-#[derive(Debug, Clone, thiserror::Error)]
-pub enum FluidError {
-    #[error("invalid fluid state at node {node} (x = {position:?}): {error}; primitive [ρ, u, v, w, p] = {prim:?}")]
-    InvalidState { node: usize, position: [f64; 3], prim: [f64; 5], error: StateError },
-    #[error("boundary `{boundary}` at node {node} (x = {position:?}): {error}")]
-    Boundary { boundary: String, node: usize, position: [f64; 3], error: RiemannError },
-    #[error(
-        "two-phase Riemann problem on edge {edge} between nodes {nodes:?} (materials {materials:?}, \
-         x = {position:?}): {error}"
-    )]
-    TwoPhase {
-        edge: usize,
-        nodes: [usize; 2],
-        materials: [MaterialId; 2],
-        position: [f64; 3],
-        error: RiemannError,
-    },
-    #[error("{0}")]
-    Wall(#[from] crate::embedded::riemann_fs::WallFluxError),
-    #[error("edge {edge} from active node {node} (x = {position:?}) to a node that is not active, not cut by the surface (taken as a slip wall): {error}")]
-    FrozenEdge { edge: usize, node: usize, position: [f64; 3], error: RiemannError },
 }
 
 /// The spatial operator: mesh, EOS table, material layout, scheme, gradient operator and

@@ -11,6 +11,7 @@ use crate::bc::BoundaryCondition;
 use crate::eos::Eos;
 use crate::flux::FluxScheme;
 use crate::initial::{Fill, InitialCondition};
+use crate::levelset::{init, LevelSet};
 use crate::memory;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec};
 use crate::mesh::{gmsh, Mesh};
@@ -54,6 +55,8 @@ pub struct Problem {
     pub dt_initial: f64,
     /// What the case asks for that the run will not do (e.g. a line time after the end).
     pub warnings: Vec<String>,
+    /// The moving interface of `[fluid.level_set]` (the initial state then holds `φ`).
+    pub level_set: Option<LevelSet>,
 }
 
 /// An error naming the case file, the line of `field` and the field.
@@ -191,7 +194,7 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
             .map(|(r, m)| (r.region, Fill { state: r.state, material: id(m) }))
             .collect(),
     };
-    let initial =
+    let mut initial =
         ic.state(&mesh, &table).map_err(|(field, message)| field_error(case, &field, message))?;
     let mut conditions = Vec::new();
     for (name, b) in &f.boundary {
@@ -272,6 +275,18 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
         &conditions,
     )
     .map_err(|e| field_error(case, "fluid.boundary", e))?;
+    // The level set: the background's fluid where φ < 0, the other where φ >= 0.
+    let level_set = match &f.level_set {
+        Some(l) => {
+            let other = (0..semi.eos.len()).find(|&m| m != background).ok_or_else(|| {
+                field_error(case, "fluid.level_set", "a level set needs two fluids")
+            })?;
+            let ls = LevelSet::new(&semi, [id(background), id(other)], l.reinit_every);
+            initial.phi = init::signed_distance(&semi.mesh, &ls, &ic, &initial.material);
+            Some(ls)
+        }
+        None => None,
+    };
     let (t_end, end_key, max_steps) = match mode {
         Mode::Alone => {
             let time = f.time.as_ref().ok_or_else(|| {
@@ -331,5 +346,6 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
         placed,
         dt_initial,
         warnings,
+        level_set,
     })
 }

@@ -10,10 +10,11 @@
 //! and the CFL step resumes after it.
 //!
 //! A restarted run is bitwise identical to an uninterrupted one: the state is the conserved
-//! array and the node materials plus `(step, t)`, and the time step depends only on them, on the
-//! target time and on the output times after `t`.
+//! array, the node materials and the level set plus `(step, t)`, and the time step and the
+//! reinitialisations depend only on them, on the target time and on the output times after `t`.
 
 use crate::embedded::{self, advance::EmbeddedRun};
+use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::output;
 use crate::probes::{Line, Placed};
 use crate::semidiscretization::Semidiscretization;
@@ -54,8 +55,9 @@ pub struct RunSummary {
     pub nodes: usize,
 }
 
-/// Reads the conserved state and node materials of the newest checkpoint under
-/// `run_dir/checkpoints` (a checkpoint without `material` is of one fluid, material 0).
+/// Reads the conserved state, node materials and level set of the newest checkpoint under
+/// `run_dir/checkpoints` (a checkpoint without `material` is of one fluid, material 0; one
+/// without `phi` has no level set).
 pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State, u64, f64)> {
     let dir = run_dir.join("checkpoints");
     let found = checkpoint::latest(&dir, &[CHECKPOINT_PART])?
@@ -66,14 +68,20 @@ pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State,
         true => ck.u8("material")?.to_vec(),
         false => vec![0; cons.len()],
     };
+    let phi = match ck.names().any(|n| n == "phi") {
+        true => ck.f64("phi")?.to_vec(),
+        false => Vec::new(),
+    };
     anyhow::ensure!(
-        cons.len() == n_nodes && material.len() == n_nodes,
-        "checkpoint {} holds {} nodes ({} material ids), but the case's mesh has {n_nodes}",
+        cons.len() == n_nodes && material.len() == n_nodes && phi.len() % n_nodes.max(1) == 0,
+        "checkpoint {} holds {} nodes ({} material ids, {} level-set values), but the case's mesh \
+         has {n_nodes}",
         found.dir.display(),
         cons.len(),
-        material.len()
+        material.len(),
+        phi.len()
     );
-    Ok((State { cons, material }, ck.step, ck.time))
+    Ok((State { cons, material, phi }, ck.step, ck.time))
 }
 
 pub use crate::setup::Mode;
@@ -114,6 +122,8 @@ pub struct FluidRun<'a> {
     status: Result<(), String>,
     /// The embedded surface of `[fluid.embedded]` (fluid-alone runs).
     embedded: Option<EmbeddedRun>,
+    /// The moving interface of `[fluid.level_set]`.
+    level_set: Option<(LevelSet, LevelSetWorkspace)>,
 }
 
 impl<'a> FluidRun<'a> {
@@ -130,7 +140,17 @@ impl<'a> FluidRun<'a> {
         for w in &problem.warnings {
             eprintln!("fluid-solver: warning: {w}");
         }
-        let Problem { mut semi, initial, stepping, t_end, max_steps, probes, placed, .. } = problem;
+        let Problem {
+            mut semi,
+            initial,
+            stepping,
+            t_end,
+            max_steps,
+            probes,
+            placed,
+            level_set,
+            ..
+        } = problem;
         let Placed { probe_nodes, mut lines } = placed;
         // Read the checkpoint before the output folder is made: it may be the same folder.
         let (state, step, t) = match &opts.restart {
@@ -141,6 +161,12 @@ impl<'a> FluidRun<'a> {
             semi.set_materials(state.material.clone())
                 .context("the checkpoint's node materials do not fit the case")?;
         }
+        if let Some(ls) = &level_set {
+            ls.check(&state).map_err(|e| {
+                anyhow::anyhow!("the state does not fit the case's [fluid.level_set]: {e}")
+            })?;
+        }
+        let level_set = level_set.map(|ls| (ls, LevelSetWorkspace::new(semi.mesh.n_nodes())));
         let policy = match mode {
             Mode::Alone => Policy::alone(opts.force, opts.restart.as_deref(), &opts.out),
             Mode::Coupled => Policy::Existing,
@@ -173,7 +199,7 @@ impl<'a> FluidRun<'a> {
         let mut fields = output::create_writer(out.path(), &semi.mesh)?;
         let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
         let probe_csv = ProbeWriter::fluid(out.path(), &names)?;
-        output::write_fields(&mut fields, &semi, t, &ws.prim)?;
+        output::write_fields(&mut fields, &semi, t, &ws.prim, &state.phi)?;
         let bar = Progress::new(t_end, opts.quiet || mode == Mode::Coupled);
         let mut run = FluidRun {
             case,
@@ -198,6 +224,7 @@ impl<'a> FluidRun<'a> {
             bar: Some(bar),
             status: Ok(()),
             embedded,
+            level_set,
         };
         run.write_probes()?;
         // Lines asked for at the start time.
@@ -293,12 +320,24 @@ impl<'a> FluidRun<'a> {
             let (step, t) = (self.step, self.t);
             let stop = self.next_stop(t_target);
             let start = Instant::now();
-            let result = match &mut self.embedded {
-                None => {
+            let result = match (&mut self.embedded, &mut self.level_set) {
+                (None, Some((ls, lws))) => ls
+                    .step(
+                        &mut self.semi,
+                        &mut self.state,
+                        &mut self.ws,
+                        lws,
+                        self.stepping,
+                        stop - t,
+                        step + 1,
+                    )
+                    .map(|s| s.dt)
+                    .map_err(anyhow::Error::from),
+                (None, None) => {
                     rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, stop - t)
                         .map_err(anyhow::Error::from)
                 }
-                Some(e) => {
+                (Some(e), _) => {
                     let (tracking, loads) = (e.tracking_s, e.loads_s);
                     let cfl = self.stepping.cfl();
                     let r = e.step(&mut self.semi, &mut self.state, &mut self.ws, cfl, t, stop);
@@ -346,7 +385,13 @@ impl<'a> FluidRun<'a> {
                 self.write_probes()?;
             }
             if want_fields {
-                output::write_fields(&mut self.fields, &self.semi, t, &self.ws.prim)?;
+                output::write_fields(
+                    &mut self.fields,
+                    &self.semi,
+                    t,
+                    &self.ws.prim,
+                    &self.state.phi,
+                )?;
                 self.last_fields_step = step;
             }
             self.write_due_lines()?;
@@ -374,13 +419,16 @@ impl<'a> FluidRun<'a> {
         self.status.is_err()
     }
 
-    /// Writes the conserved state and node materials as the checkpoint `tag` (part
+    /// Writes the conserved state, node materials and level set as the checkpoint `tag` (part
     /// [`CHECKPOINT_PART`]).
     pub fn write_checkpoint(&mut self, tag: &str) -> anyhow::Result<()> {
         let start = Instant::now();
         let mut ck = Checkpoint::new(self.step, self.t);
         ck.put_f64_n("cons", &self.state.cons)?;
         ck.put("material", self.state.material.clone())?;
+        if !self.state.phi.is_empty() {
+            ck.put("phi", self.state.phi.clone())?;
+        }
         ck.write(&self.out.checkpoints()?, tag, CHECKPOINT_PART)?;
         self.timers.add_since(bucket::OUTPUT, start);
         Ok(())
@@ -396,7 +444,8 @@ impl<'a> FluidRun<'a> {
             let start = Instant::now();
             self.semi.primitives(&self.state.cons, &mut self.ws)?;
             if self.last_fields_step != self.step {
-                output::write_fields(&mut self.fields, &self.semi, self.t, &self.ws.prim)?;
+                let phi = &self.state.phi;
+                output::write_fields(&mut self.fields, &self.semi, self.t, &self.ws.prim, phi)?;
             }
             for line in &self.lines {
                 let sample = line.sample(&self.ws.prim, &self.state.material);

@@ -7,24 +7,33 @@
 //! ([`crate::mesh::EdgeBlocks`]).
 //!
 //! Two-phase flow (DESIGN §5, thesis Ch. 3): each node holds a material id, its fluid's index in
-//! the EOS table of [`crate::semidiscretization::Semidiscretization`]; the level set will be one
-//! more array here. MPI adds ghost nodes after the owned ones.
+//! the EOS table of [`crate::semidiscretization::Semidiscretization`], and with a moving interface
+//! the level set `φ` ([`crate::levelset`]): its sign gives the material. MPI adds ghost nodes after
+//! the owned ones.
 
 /// A node's material: its fluid's index in the EOS table.
 pub type MaterialId = u8;
 
-/// Conserved variables `[ρ, ρu, ρv, ρw, E]` and the material id of every node.
+/// Conserved variables `[ρ, ρu, ρv, ρw, E]`, the material id and the level set of every node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
     pub cons: Vec<[f64; 5]>,
     pub material: Vec<MaterialId>,
+    /// The level set `φ` of the interface between two fluids, one per node; empty when the
+    /// interface does not move (one fluid, or a fixed material layout).
+    pub phi: Vec<f64>,
 }
 
 impl State {
     /// A state of one fluid (material 0 everywhere).
     pub fn new(cons: Vec<[f64; 5]>) -> State {
         let material = vec![0; cons.len()];
-        State { cons, material }
+        State { cons, material, phi: Vec::new() }
+    }
+
+    /// A state of several fluids with a fixed layout (no level set).
+    pub fn with_materials(cons: Vec<[f64; 5]>, material: Vec<MaterialId>) -> State {
+        State { cons, material, phi: Vec::new() }
     }
 
     /// Number of nodes.
@@ -38,7 +47,9 @@ impl State {
 
     /// Memory in bytes.
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(&self.cons[..]) + std::mem::size_of_val(&self.material[..])
+        std::mem::size_of_val(&self.cons[..])
+            + std::mem::size_of_val(&self.material[..])
+            + std::mem::size_of_val(&self.phi[..])
     }
 }
 

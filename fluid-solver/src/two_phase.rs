@@ -13,9 +13,14 @@
 //! carries, so the scheme is not conservative at the interface: `Σ_i R_i` equals the boundary flux
 //! plus `Σ (F_i - F_j)` over the two-material edges (zero for a contact at rest at equal
 //! pressure, whose two fluxes are both the pressure flux `p ν`).
+//!
+//! Cavitation (DESIGN §5.1): the star pressure is cut off at the larger of the two fluids'
+//! default cut-offs ([`cutoff`]), so a liquid next to a gas never returns tension.
 
-use crate::flux::two_phase_flux;
+use crate::eos::Eos;
+use crate::flux::two_phase_flux_with_cutoff;
 use crate::mesh::blocks::Window;
+use crate::riemann::PressureCutoff;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 
 /// Adds the two-phase fluxes of edge `e` (its ends hold different materials) to the residuals of
@@ -29,13 +34,15 @@ pub(crate) fn edge_flux(
     let mesh = &semi.mesh;
     let [i, j] = mesh.edges[e];
     let (i, j) = (i as usize, j as usize);
-    let f = two_phase_flux(
+    let (eos_i, eos_j) = (semi.eos_at(i), semi.eos_at(j));
+    let f = two_phase_flux_with_cutoff(
         semi.numerics.flux,
-        semi.eos_at(i),
+        eos_i,
         &prim[i],
-        semi.eos_at(j),
+        eos_j,
         &prim[j],
         &mesh.edge_normals[e],
+        cutoff(eos_i, eos_j),
     )
     .map_err(|error| {
         let m = semi.material();
@@ -54,4 +61,13 @@ pub(crate) fn edge_flux(
         r[j][k] -= f.flux_j[k];
     }
     Ok(())
+}
+
+/// The cavitation cut-off of a two-phase problem between `a` and `b`: the larger of their
+/// defaults ([`PressureCutoff::default_for`]: the vapour pressure of water for a liquid, none for
+/// a perfect gas).
+#[inline]
+pub fn cutoff(a: &Eos, b: &Eos) -> PressureCutoff {
+    let p_cut = PressureCutoff::default_for(a).p_cut.max(PressureCutoff::default_for(b).p_cut);
+    PressureCutoff { p_cut }
 }

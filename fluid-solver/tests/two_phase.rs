@@ -57,7 +57,7 @@ fn two_fluids(
     let semi =
         Semidiscretization::with_materials(mesh, vec![WATER, AIR], material.clone(), numerics, bcs)
             .unwrap();
-    (semi, State { cons, material })
+    (semi, State::with_materials(cons, material))
 }
 
 /// An oblique plane through the box: water on the side of the origin.

@@ -3,7 +3,7 @@
 
 use super::{numerical_flux, FluxScheme};
 use crate::eos::Eos;
-use crate::riemann::{self, RiemannError, StarState, State1d};
+use crate::riemann::{self, PressureCutoff, RiemannError, StarState, State1d};
 
 /// Flux through a facet bounded by a wall, with the fluid state at the wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,15 +64,32 @@ pub fn two_phase_flux(
     wj: &[f64; 5],
     n: &[f64; 3],
 ) -> Result<TwoPhaseFlux, RiemannError> {
+    two_phase_flux_with_cutoff(scheme, eos_i, wi, eos_j, wj, n, PressureCutoff::OFF)
+}
+
+/// [`two_phase_flux`] with the cavitation cut-off `cut` on the star pressure
+/// ([`riemann::solve_with_cutoff`]).
+#[inline]
+pub fn two_phase_flux_with_cutoff(
+    scheme: FluxScheme,
+    eos_i: &Eos,
+    wi: &[f64; 5],
+    eos_j: &Eos,
+    wj: &[f64; 5],
+    n: &[f64; 3],
+    cut: PressureCutoff,
+) -> Result<TwoPhaseFlux, RiemannError> {
     let (nh, _) = super::unit(n);
     let uni = wi[1] * nh[0] + wi[2] * nh[1] + wi[3] * nh[2];
     let unj = wj[1] * nh[0] + wj[2] * nh[1] + wj[3] * nh[2];
-    let star = riemann::solve(
+    let star = riemann::solve_with_cutoff(
         eos_i,
         State1d { rho: wi[0], u: uni, p: wi[4] },
         eos_j,
         State1d { rho: wj[0], u: unj, p: wj[4] },
-    )?;
+        cut,
+    )?
+    .state;
     let with_normal_velocity = |w: &[f64; 5], un: f64, rho: f64| {
         let dv = star.u - un;
         [rho, w[1] + dv * nh[0], w[2] + dv * nh[1], w[3] + dv * nh[2], star.p]

@@ -4,6 +4,7 @@
 use super::cfl::{stable_time_step, TimeStepping};
 use crate::embedded::step::{EmbeddedStep, Wall};
 use crate::embedded::tracker::Tracker;
+use crate::levelset::{advect, LevelSet, LevelSetWorkspace};
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::state::{State, Workspace};
 
@@ -28,8 +29,76 @@ pub fn rk2_step(
         let dt = if local { (cfl * dt_node[i]).min(dt_max) } else { dt_global };
         dt / semi.mesh.volumes[i]
     };
-    let result = stages(semi, state, ws, ratio, None);
+    let result = stages(semi, &mut state.cons, ws, ratio, None, |_, _| {});
     ws.dt_node = dt_node;
+    result.map(|()| dt_global)
+}
+
+/// [`rk2_step`] of the flow and the level set together (thesis Eq. 3.8 with 3.10-3.13): each
+/// stage advances `φ` with the velocities of that stage's flow state by the same update
+/// ([`advect`]), `φ¹ = φⁿ - Δt/|C| R^φ(φⁿ, Wⁿ)`, `φⁿ⁺¹ = ½ φⁿ + ½ (φ¹ - Δt/|C| R^φ(φ¹, W¹))`, on the
+/// material layout of `semi` (the caller updates the materials afterwards). On error `state` is
+/// unchanged.
+pub fn rk2_step_level_set(
+    semi: &Semidiscretization,
+    ls: &LevelSet,
+    state: &mut State,
+    ws: &mut Workspace,
+    lws: &mut LevelSetWorkspace,
+    stepping: TimeStepping,
+    dt_max: f64,
+) -> Result<f64, FluidError> {
+    let dt_min = stable_time_step(semi, &state.cons, ws)?;
+    let dt_global = (stepping.cfl() * dt_min).min(dt_max);
+    let local = matches!(stepping, TimeStepping::Local { .. });
+    let cfl = stepping.cfl();
+    let dt_node = std::mem::take(&mut ws.dt_node);
+    let ratio = |i: usize| {
+        let dt = if local { (cfl * dt_node[i]).min(dt_max) } else { dt_global };
+        dt / semi.mesh.volumes[i]
+    };
+    let mut phi_stage = std::mem::take(&mut lws.stage);
+    let State { cons, phi, .. } = state;
+    let phi_n = &phi[..];
+    let limiter = semi.numerics.limiter;
+    let mesh = &semi.mesh;
+    // `ws.prim` holds the primitives of the stage's flow state when each stage's flow pass ends.
+    let result = stages(semi, cons, ws, ratio, None, |stage, ws| {
+        if stage == 0 {
+            for (s, p) in lws.phi.iter_mut().zip(phi_n) {
+                s[0] = *p;
+            }
+            advect::residual_and_update(
+                mesh,
+                &ls.gradient,
+                limiter,
+                &ls.open,
+                &ws.prim,
+                lws,
+                &mut phi_stage,
+                |i, r, p1| *p1 = phi_n[i] - ratio(i) * r,
+            );
+        } else {
+            for (s, p) in lws.phi.iter_mut().zip(&phi_stage) {
+                s[0] = *p;
+            }
+            advect::residual_and_update(
+                mesh,
+                &ls.gradient,
+                limiter,
+                &ls.open,
+                &ws.prim,
+                lws,
+                &mut phi_stage,
+                |i, r, p| *p = 0.5 * phi_n[i] + 0.5 * (*p - ratio(i) * r),
+            );
+        }
+    });
+    ws.dt_node = dt_node;
+    if result.is_ok() {
+        std::mem::swap(phi, &mut phi_stage);
+    }
+    lws.stage = phi_stage;
     result.map(|()| dt_global)
 }
 
@@ -48,20 +117,23 @@ pub fn rk2_step_embedded(
     let ratio = |i: usize| if tracker.active[i] { dt / semi.mesh.volumes[i] } else { 0.0 };
     let (t_a, t_b) = (tracker.surface.t_a, tracker.surface.t_b);
     let walls = [Wall { step, tracker, t: t_a }, Wall { step, tracker, t: t_b }];
-    stages(semi, state, ws, ratio, Some(walls))
+    stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {})
 }
 
 /// The two stages with `ratio(i) = Δt_i / |C_i|` (zero freezes a node), each with its wall; the
-/// new state is built in `ws.stage` and swapped in at the end.
+/// new state is built in `ws.stage` and swapped in at the end. After each stage's pass,
+/// `after(stage, ws)` runs with `ws.prim` still the primitives that pass read (of `Wⁿ`, then of
+/// `W¹`).
 fn stages(
     semi: &Semidiscretization,
-    state: &mut State,
+    state_cons: &mut Vec<[f64; 5]>,
     ws: &mut Workspace,
     ratio: impl Fn(usize) -> f64 + Sync,
     walls: Option<[Wall<'_>; 2]>,
+    mut after: impl FnMut(usize, &mut Workspace),
 ) -> Result<(), FluidError> {
     let mut stage = std::mem::take(&mut ws.stage);
-    let cons = &state.cons;
+    let cons = &state_cons[..];
     // Stage 1: W¹ = Wⁿ - Δt/|C| R(Wⁿ), into `stage`.
     let mut result = semi.residual_and_update_with(
         ws,
@@ -74,6 +146,9 @@ fn stages(
         },
         walls.map(|w| w[0]),
     );
+    if result.is_ok() {
+        after(0, ws);
+    }
     // Stage 2: Wⁿ⁺¹ = ½ Wⁿ + ½ (W¹ - Δt/|C| R(W¹)), in place of W¹ in `stage`.
     if result.is_ok() {
         result = semi.primitives(&stage, ws).and_then(|()| {
@@ -89,9 +164,12 @@ fn stages(
                 walls.map(|w| w[1]),
             )
         });
+        if result.is_ok() {
+            after(1, ws);
+        }
     }
     if result.is_ok() {
-        std::mem::swap(&mut state.cons, &mut stage);
+        std::mem::swap(state_cons, &mut stage);
     }
     ws.stage = stage;
     result

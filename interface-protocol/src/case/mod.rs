@@ -12,17 +12,21 @@
 mod coupling;
 mod embedded;
 mod fluid;
+mod level_set;
 mod locate;
 mod output;
 mod piston;
+mod region;
 mod rigid;
 mod structure;
 
 pub use coupling::*;
 pub use embedded::*;
 pub use fluid::*;
+pub use level_set::*;
 pub use output::*;
 pub use piston::*;
+pub use region::*;
 pub use rigid::*;
 pub use structure::*;
 

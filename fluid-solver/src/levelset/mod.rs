@@ -1,0 +1,202 @@
+//! The moving interface between two fluids (thesis §3.3.2, Eq. 3.8; DESIGN §5): a level set `φ`
+//! per node, advected with the flow, whose sign gives each node's fluid; the ghost-fluid fluxes
+//! of [`crate::two_phase`] then act at the edges whose ends hold different fluids.
+//!
+//! One step ([`LevelSet::step`]):
+//! 1. the flow and `φ` advance together by one RK2 step on the material layout of `t^n`
+//!    ([`crate::time::rk2::rk2_step_level_set`], `φ` by [`advect`]);
+//! 2. each node's material becomes the side of `φ^{n+1}` ([`LevelSet::material_of`]); a node
+//!    whose material changed takes the ghost state of the exact two-phase Riemann problem on its
+//!    edges to nodes of its new fluid ([`ghost`]), its conserved variables recomputed with the new
+//!    EOS, and the operator's layout (special edges, masked gradients) is rebuilt;
+//! 3. every `reinit_every` steps `φ` is reset to a signed distance with the nodes of
+//!    sign-changing edges frozen ([`reinit`]), so reinitialisation never moves the interface and
+//!    never changes a material.
+//!
+//! Form: `φ_t + u·∇φ = 0` (Eq. 3.8), not the conservative `(ρφ)_t + ∇·(ρφu) = 0`. The ghost-fluid
+//! method carries two different fluxes on each interface edge and lets the density jump by three
+//! orders of magnitude there, so a mass flux of `ρφ` is neither single-valued at the interface nor
+//! smooth across it, while `φ` and `u` are both continuous there: the advective form needs only
+//! the velocity, takes its gradient straight across the interface, and keeps `φ` a distance
+//! between reinitialisations. Its edge form (see [`advect`]) is upwind MUSCL on `φ` with the
+//! scheme's limiter, second order where `φ` and `u` are smooth.
+
+pub mod advect;
+pub mod ghost;
+pub mod gradient;
+pub mod init;
+pub mod reinit;
+
+use crate::bc::BoundaryCondition;
+use crate::embedded::adjacency::NodeEdges;
+use crate::reconstruct::gradient::LsqGradient;
+use crate::semidiscretization::{FluidError, Semidiscretization};
+use crate::state::{MaterialId, State, Workspace};
+use crate::time::rk2::rk2_step_level_set;
+use crate::time::TimeStepping;
+
+/// The level set of one interface between two fluids, its settings and the operators built
+/// once per mesh.
+#[derive(Debug, Clone)]
+pub struct LevelSet {
+    /// The material where `φ < 0` and where `φ >= 0`.
+    pub materials: [MaterialId; 2],
+    /// Steps between reinitialisations (0: never).
+    pub reinit_every: u64,
+    /// Least-squares gradients of `φ`: through every edge (across the material interface), with
+    /// the mirror planes of the flow's operator ([`gradient`]).
+    pub gradient: LsqGradient,
+    /// Node-to-edge adjacency, for the ghost states and the reinitialisation.
+    pub adjacency: NodeEdges,
+    /// The nodes on far-field, inflow and outflow boundaries (first-order `φ` there, [`advect`]).
+    pub open: Vec<bool>,
+}
+
+/// Scratch arrays of the level set, allocated once per mesh.
+#[derive(Debug, Clone)]
+pub struct LevelSetWorkspace {
+    /// `φ` of the current stage, as the gradient operator reads it.
+    pub phi: Vec<[f64; 1]>,
+    /// `∇φ` of the current stage.
+    pub grad: Vec<[[f64; 3]; 1]>,
+    /// `R^φ_i`.
+    pub residual: Vec<f64>,
+    /// `φ¹`, then `φ^{n+1}` while the step is built.
+    pub stage: Vec<f64>,
+}
+
+impl LevelSetWorkspace {
+    pub fn new(n_nodes: usize) -> LevelSetWorkspace {
+        LevelSetWorkspace {
+            phi: vec![[0.0]; n_nodes],
+            grad: vec![[[0.0; 3]]; n_nodes],
+            residual: vec![0.0; n_nodes],
+            stage: vec![0.0; n_nodes],
+        }
+    }
+
+    /// Memory in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.phi[..])
+            + size_of_val(&self.grad[..])
+            + size_of_val(&self.residual[..])
+            + size_of_val(&self.stage[..])
+    }
+}
+
+/// What a step did to the interface.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InterfaceStep {
+    /// The step taken.
+    pub dt: f64,
+    /// Nodes whose material changed.
+    pub changed: usize,
+    /// Whether `φ` was reinitialised after the step.
+    pub reinitialised: bool,
+}
+
+impl LevelSet {
+    /// The level set between `materials[0]` (`φ < 0`) and `materials[1]` (`φ >= 0`) on the
+    /// operator's mesh, reinitialised every `reinit_every` steps.
+    pub fn new(
+        semi: &Semidiscretization,
+        materials: [MaterialId; 2],
+        reinit_every: u64,
+    ) -> LevelSet {
+        let mut open = vec![false; semi.mesh.n_nodes()];
+        for &(b, bc) in &semi.patches {
+            if !matches!(bc, BoundaryCondition::SlipWall | BoundaryCondition::Symmetry) {
+                for &i in &semi.mesh.boundaries[b].nodes {
+                    open[i as usize] = true;
+                }
+            }
+        }
+        LevelSet {
+            materials,
+            reinit_every,
+            gradient: gradient::phi_gradient(semi),
+            adjacency: NodeEdges::build(&semi.mesh),
+            open,
+        }
+    }
+
+    /// The side of `φ`: 0 where `φ < 0`, 1 where `φ >= 0` (a node exactly on the interface
+    /// belongs to the `φ >= 0` fluid, as a point on a region's surface is inside it).
+    #[inline(always)]
+    pub fn side(phi: f64) -> usize {
+        usize::from(phi >= 0.0)
+    }
+
+    /// The material of a node with level set `phi`.
+    #[inline(always)]
+    pub fn material_of(&self, phi: f64) -> MaterialId {
+        self.materials[Self::side(phi)]
+    }
+
+    /// Checks that `state` carries a level set consistent with its materials: one `φ` per node,
+    /// finite, and each node's material the one of its side.
+    pub fn check(&self, state: &State) -> Result<(), String> {
+        if state.phi.len() != state.len() {
+            return Err(format!(
+                "{} level-set values for {} nodes (a state without a level set?)",
+                state.phi.len(),
+                state.len()
+            ));
+        }
+        for (i, (&phi, &m)) in state.phi.iter().zip(&state.material).enumerate() {
+            if !phi.is_finite() {
+                return Err(format!("node {i}: level set φ = {phi} is not finite"));
+            }
+            if self.material_of(phi) != m {
+                return Err(format!(
+                    "node {i}: material {m} but level set φ = {phi:e} gives material {}",
+                    self.material_of(phi)
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// One step of the flow and the interface (module docs): RK2 of the flow and `φ` no longer
+    /// than `dt_max`, the new materials and ghost states, the operator's layout, and the
+    /// reinitialisation when `step_number` (the number of this step, from 1) is a multiple of
+    /// `reinit_every`. On error `state` and `semi` are unchanged.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &self,
+        semi: &mut Semidiscretization,
+        state: &mut State,
+        ws: &mut Workspace,
+        lws: &mut LevelSetWorkspace,
+        stepping: TimeStepping,
+        dt_max: f64,
+        step_number: u64,
+    ) -> Result<InterfaceStep, FluidError> {
+        let mut next = state.clone();
+        let dt = rk2_step_level_set(semi, self, &mut next, ws, lws, stepping, dt_max)?;
+        let moved = next.phi.iter().zip(&next.material).any(|(&p, &m)| self.material_of(p) != m);
+        if moved {
+            // The interface normals of the ghost states: ∇φⁿ⁺¹.
+            for (s, p) in lws.phi.iter_mut().zip(&next.phi) {
+                s[0] = *p;
+            }
+            self.gradient.compute(&semi.mesh, &lws.phi, &mut lws.grad);
+        }
+        let changed = ghost::update_materials(semi, self, &lws.grad, &mut next)?;
+        if changed > 0 {
+            semi.set_materials(next.material.clone())
+                .map_err(|e| FluidError::LevelSet(e.to_string()))?;
+        }
+        let reinitialised = self.reinit_every > 0 && step_number % self.reinit_every == 0;
+        if reinitialised {
+            for (s, p) in lws.phi.iter_mut().zip(&next.phi) {
+                s[0] = *p;
+            }
+            self.gradient.compute(&semi.mesh, &lws.phi, &mut lws.grad);
+            reinit::reinitialise(&semi.mesh, &self.adjacency, &lws.grad, &mut next.phi);
+        }
+        *state = next;
+        Ok(InterfaceStep { dt, changed, reinitialised })
+    }
+}
