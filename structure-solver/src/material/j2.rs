@@ -142,6 +142,39 @@ pub struct PlaneStressConstants<R> {
 /// bracket each update, so this many reach round-off from any bracket.
 pub const FALLBACK_UPDATES: usize = 120;
 
+/// `f`, `f'` and `κ` of the plane-stress return at `Δγ` (see [`return_plane_stress_with`]).
+/// A function rather than a closure so that it is inlined into, and compiled with the vector
+/// width of, the SIMD kernel that calls the return.
+#[inline(always)]
+fn return_eval<R: Real>(
+    m: &PlaneStressConstants<R>,
+    a1: R,
+    a2: R,
+    kappa_n: R,
+    dgamma: R,
+) -> (R, R, R) {
+    let (c1, c2, h, one) = (m.c1, m.c2, m.h, R::splat(1.0));
+    let (i1, i2) = (one / (one + c1 * dgamma), one / (one + c2 * dgamma));
+    let (q1, q2) = (a1 * i1 * i1, a2 * i2 * i2);
+    let xi2 = q1 + q2;
+    let xi = xi2.sqrt();
+    let dxi2 = R::splat(-2.0) * (q1 * c1 * i1 + q2 * c2 * i2);
+    let kappa = kappa_n + h * R::splat(SQRT_2_3) * dgamma * xi;
+    let f = R::splat(0.5) * xi2 - R::splat(1.0 / 3.0) * kappa * kappa;
+    // dκ/dΔγ = H sqrt(2/3) (ξ + Δγ ξ'), ξ' = (ξ²)' / (2ξ).
+    let dkappa = h * R::splat(SQRT_2_3) * (xi + dgamma * dxi2 * R::splat(0.5) / xi);
+    let df = R::splat(0.5) * dxi2 - R::splat(2.0 / 3.0) * kappa * dkappa;
+    (f, df, kappa)
+}
+
+/// Lanes of the return still to update: yielding and outside the tolerance. A lane stops when
+/// it converges, so its result does not depend on the other lanes of its block.
+#[inline(always)]
+fn return_active<R: Real>(yielding: R::Mask, f: R, kappa: R, tol: f64) -> R::Mask {
+    let excess = R::select(yielding, f.abs() - R::splat(tol) * kappa * kappa, -R::splat(1.0));
+    excess.gt(R::splat(0.0))
+}
+
 /// Plane-stress closest point projection from a trial stress `[σxx, σyy, σxy]` (Simo-Taylor
 /// 1986; Simo-Hughes Box 3.3): Newton updates of `Δγ` on `f(Δγ) = ½ ξ² - ⅓ κ²`,
 /// `ξ² = σ(Δγ)ᵀ P σ(Δγ)`, `κ = κ_n + H sqrt(⅔) Δγ ξ`, from the radial-return estimate.
@@ -176,48 +209,28 @@ pub fn return_plane_stress_with<R: Real>(
     let yielding = f_trial.gt(zero);
     let mut dgamma = zero;
     if R::any(yielding) {
-        // f, f' and κ at Δγ.
-        let eval = |dgamma: R| {
-            let (i1, i2) = (one / (one + c1 * dgamma), one / (one + c2 * dgamma));
-            let (q1, q2) = (a1 * i1 * i1, a2 * i2 * i2);
-            let xi2 = q1 + q2;
-            let xi = xi2.sqrt();
-            let dxi2 = R::splat(-2.0) * (q1 * c1 * i1 + q2 * c2 * i2);
-            let kappa = kappa_n + h * R::splat(SQRT_2_3) * dgamma * xi;
-            let f = R::splat(0.5) * xi2 - R::splat(1.0 / 3.0) * kappa * kappa;
-            // dκ/dΔγ = H sqrt(2/3) (ξ + Δγ ξ'), ξ' = (ξ²)' / (2ξ).
-            let dkappa = h * R::splat(SQRT_2_3) * (xi + dgamma * dxi2 * R::splat(0.5) / xi);
-            let df = R::splat(0.5) * dxi2 - R::splat(2.0 / 3.0) * kappa * dkappa;
-            (f, df, kappa)
-        };
-        // Lanes to update: yielding and outside the tolerance; a lane stops when it converges,
-        // so its result does not depend on the other lanes of its block.
-        let active = |f: R, kappa: R| {
-            let excess = R::select(yielding, f.abs() - R::splat(tol) * kappa * kappa, -one);
-            excess.gt(zero)
-        };
         // Start from the radial-return estimate (every component scaled by 1/(1 + 2GΔγ)):
         // ξ_tr (1 - ⅔ H Δγ) = sqrt(⅔) κ_n (1 + 2 G Δγ).
         let xi_tr = (a1 + a2).sqrt();
         let k_n = R::splat(SQRT_2_3) * kappa_n;
         let guess = (xi_tr - k_n) / (R::splat(2.0 / 3.0) * h * xi_tr + c2 * k_n);
         dgamma = R::select(yielding, guess, dgamma);
-        let (mut f, mut df, mut kappa) = eval(dgamma);
+        let (mut f, mut df, mut kappa) = return_eval(m, a1, a2, kappa_n, dgamma);
         for i in 0..max_newton {
-            let act = active(f, kappa);
+            let act = return_active(yielding, f, kappa, tol);
             if !R::any(act) {
                 break;
             }
             dgamma = R::select(act, dgamma - f / df, dgamma);
             if i + 1 < max_newton || tol > 0.0 {
-                (f, df, kappa) = eval(dgamma);
+                (f, df, kappa) = return_eval(m, a1, a2, kappa_n, dgamma);
             }
         }
-        if tol > 0.0 && R::any(active(f, kappa)) {
+        if tol > 0.0 && R::any(return_active(yielding, f, kappa, tol)) {
             let mut lo = zero;
             let mut hi = (xi_tr / k_n - one) / c1.min(c2);
             for _ in 0..FALLBACK_UPDATES {
-                let act = active(f, kappa);
+                let act = return_active(yielding, f, kappa, tol);
                 if !R::any(act) {
                     break;
                 }
@@ -230,7 +243,7 @@ pub fn return_plane_stress_with<R: Real>(
                 let inside = R::select(newton.gt(lo), newton, mid);
                 let step = R::select(hi.gt(inside), inside, mid);
                 dgamma = R::select(act, step, dgamma);
-                (f, df, kappa) = eval(dgamma);
+                (f, df, kappa) = return_eval(m, a1, a2, kappa_n, dgamma);
             }
         }
     }

@@ -107,18 +107,23 @@ impl Constants<V> {
     /// Lane `l` takes the constants `of(l)`.
     #[inline(always)]
     pub fn gather<'a>(of: impl Fn(usize) -> &'a Constants<f64>) -> Self {
-        let lanes = |g: &dyn Fn(&Constants<f64>) -> f64| Lanes(std::array::from_fn(|l| g(of(l))));
+        let cs: [&Constants<f64>; LANES] = std::array::from_fn(of);
+        macro_rules! lanes {
+            ($($f:ident).+) => {
+                Lanes(std::array::from_fn(|l| cs[l].$($f).+))
+            };
+        }
         Constants {
-            c00: lanes(&|c| c.c00),
-            c01: lanes(&|c| c.c01),
-            c22: lanes(&|c| c.c22),
-            gk: lanes(&|c| c.gk),
-            e: lanes(&|c| c.e),
+            c00: lanes!(c00),
+            c01: lanes!(c01),
+            c22: lanes!(c22),
+            gk: lanes!(gk),
+            e: lanes!(e),
             ret: PlaneStressConstants {
-                c1: lanes(&|c| c.ret.c1),
-                c2: lanes(&|c| c.ret.c2),
-                h: lanes(&|c| c.ret.h),
-                sigma_y: lanes(&|c| c.ret.sigma_y),
+                c1: lanes!(ret.c1),
+                c2: lanes!(ret.c2),
+                h: lanes!(ret.h),
+                sigma_y: lanes!(ret.sigma_y),
             },
         }
     }
