@@ -10,7 +10,7 @@ use interface_protocol::case::{
     StructureMaterial, StructureSection, Symmetry,
 };
 
-use crate::assembly::{AssemblyError, Curve, FeModel, Part, RotaryInertia};
+use crate::assembly::{Curve, FeModel, Part, RotaryInertia};
 use crate::case_mesh::build_mesh;
 use crate::elements::{BeamSection, BeamYield, ShellSection, ShellYield};
 use crate::material::{Elastic, Material, J2};
@@ -177,6 +177,8 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
     let top = s.parts.is_empty();
     let top_dim = mesh.cells.iter().map(|c| dimension(c.kind)).max().unwrap_or(0);
     let mut out: Vec<Option<(usize, Part)>> = vec![None; mesh.cells.len()];
+    // the first J2 bt4 part and its thickness points: the others must have as many
+    let mut bt4_points: Option<(usize, usize)> = None;
     for (k, p) in parts.iter().enumerate() {
         let f = |key: &str| {
             if top {
@@ -199,10 +201,25 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
         };
         let h = p.thickness.unwrap_or_default();
         let (section, yield_) = shell(m, h, p.points);
+        if let (ElementType::Bt4, Some(y)) = (p.element, yield_) {
+            let (first, n) = *bt4_points.get_or_insert((k, y.points));
+            if n != y.points {
+                return Err(field_error(
+                    case,
+                    &f("points"),
+                    format!(
+                        "J2 bt4 parts share one number of thickness points: \
+                         structure.parts[{first}] has {n}, this part {}",
+                        y.points
+                    ),
+                ));
+            }
+        }
         for c in cells {
             let kind = mesh.cells[c].kind;
             let part = match (p.element, kind) {
-                (ElementType::Bt4, CellKind::Quad4) => Part::Bt4(section, yield_),
+                // the cell decides: BT4 on quadrilaterals, BLT3 on triangles
+                (ElementType::Bt4, CellKind::Quad4 | CellKind::Tri3) => Part::Bt4(section, yield_),
                 (ElementType::Mitc4, CellKind::Quad4)
                 | (ElementType::Dkt, CellKind::Tri3)
                 | (ElementType::Shell, CellKind::Quad4 | CellKind::Tri3) => match yield_ {
@@ -241,9 +258,9 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                 }
                 (e, kind) => {
                     let needs = match e {
-                        ElementType::Bt4 | ElementType::Mitc4 => "quadrilaterals",
+                        ElementType::Mitc4 => "quadrilaterals",
                         ElementType::Dkt => "triangles",
-                        ElementType::Shell => "triangles or quadrilaterals",
+                        ElementType::Bt4 | ElementType::Shell => "triangles or quadrilaterals",
                         ElementType::Beam => "2-node lines",
                         ElementType::Tet4 => "tetrahedra",
                     };
@@ -306,14 +323,8 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
         ..Mesh::default()
     };
     let part = |i: usize| parts[kept[i]].expect("kept cells have a part");
-    let mut fe = FeModel::new(&elements, part).map_err(|e| match e {
-        AssemblyError::Bt4Material { .. } => field_error(
-            case,
-            "structure.parts",
-            "all bt4 parts share one material and number of thickness points",
-        ),
-        e => field_error(case, "structure.parts", e),
-    })?;
+    let mut fe =
+        FeModel::new(&elements, part).map_err(|e| field_error(case, "structure.parts", e))?;
     fe.set_rotary_inertia(rotary);
     let mut mesh = mesh;
     // Rigid body of each slave node.
@@ -460,9 +471,12 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
         }
     }
     let is_bt4 = |c: &usize| matches!(parts[*c], Some(Part::Bt4(..)));
+    let cells_of = &mesh.cells;
+    let kind = |k: CellKind| move |c: &usize| is_bt4(c) && cells_of[*c].kind == k;
     let cells = CellMap {
         elements: kept.iter().copied().filter(|c| !is_bt4(c)).collect(),
-        bt4: kept.iter().copied().filter(is_bt4).collect(),
+        bt4: kept.iter().copied().filter(kind(CellKind::Quad4)).collect(),
+        blt3: kept.iter().copied().filter(kind(CellKind::Tri3)).collect(),
         n_cells: mesh.cells.len(),
     };
     let thinnest = parts

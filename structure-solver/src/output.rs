@@ -4,10 +4,10 @@
 //!
 //! Cell fields ([`cell_fields`]): the von Mises stress of every element (`Element::von_mises`:
 //! shells the largest through the thickness, beams the largest corner stress, tets from the
-//! Cauchy stress; BT4 shells the largest over their thickness points), and the largest
-//! equivalent plastic strain through the thickness of J2 shells and BT4 shells (tets: at their
-//! point) when the model has plastic states. `structure_cells.csv` holds the final cell fields
-//! with the cell centroids.
+//! Cauchy stress; BT4 and BLT3 shells the largest over their thickness points), and the
+//! largest equivalent plastic strain through the thickness of J2 shells and explicit shells
+//! (tets: at their point) when the model has plastic states. `structure_cells.csv` holds the
+//! final cell fields with the cell centroids.
 
 use std::io::Write;
 use std::path::Path;
@@ -24,24 +24,27 @@ use crate::elements::ElementKind;
 use crate::mesh::{CellKind, Mesh};
 use crate::model::Model;
 
-/// Which mesh cells are the model's elements (`FeModel::elements`, in order) and which its
-/// BT4 shells (`FeModel::bt4`, in order), of `n_cells` (cells of no part carry zeros).
+/// Which mesh cells are the model's elements (`FeModel::elements`, in order), its BT4 shells
+/// (`FeModel::bt4`, in order) and its BLT3 shells (`FeModel::blt3`, in order), of `n_cells`
+/// (cells of no part carry zeros).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CellMap {
     pub elements: Vec<usize>,
     pub bt4: Vec<usize>,
+    pub blt3: Vec<usize>,
     pub n_cells: usize,
 }
 
 /// The committed cell fields of `model`, one value per mesh cell: `von_mises` of every element
-/// (`Element::von_mises`; BT4 shells the largest over their thickness points), and
-/// `plastic_strain` when some element has a J2 state or the model has BT4 shells.
+/// (`Element::von_mises`; BT4 and BLT3 shells the largest over their thickness points, BLT3
+/// with the mean transverse shear stress `Q/h`), and `plastic_strain` when some element has a
+/// J2 state or the model has explicit shells.
 pub fn cell_fields(model: &FeModel, map: &CellMap) -> Vec<(&'static str, Vec<f64>)> {
     let n = map.n_cells;
-    let bt4 = model.bt4();
+    let (bt4, blt3) = (model.bt4(), model.blt3());
     let has_state = (0..model.elements().len()).any(|e| !model.element_state(e).is_empty());
     let mut out = Vec::new();
-    if has_state || bt4.is_some() {
+    if has_state || bt4.is_some() || blt3.is_some() {
         let mut ep = vec![0.0; n];
         for (e, &c) in map.elements.iter().enumerate() {
             let st = model.element_state(e);
@@ -59,6 +62,12 @@ pub fn cell_fields(model: &FeModel, map: &CellMap) -> Vec<(&'static str, Vec<f64
                 ep[c] = (0..np).map(|p| b.plastic_strain(e, p)).fold(0.0, f64::max);
             }
         }
+        if let Some(b) = blt3 {
+            let np = b.settings.rule.len();
+            for (e, &c) in map.blt3.iter().enumerate() {
+                ep[c] = (0..np).map(|p| b.plastic_strain(e, p)).fold(0.0, f64::max);
+            }
+        }
         out.push(("plastic_strain", ep));
     }
     let mut vm = vec![0.0; n];
@@ -72,6 +81,18 @@ pub fn cell_fields(model: &FeModel, map: &CellMap) -> Vec<(&'static str, Vec<f64
         let np = b.settings.rule.len();
         for (e, &c) in map.bt4.iter().enumerate() {
             vm[c] = (0..np).map(|p| shell_von_mises(&b.stress(e, p))).fold(0.0, f64::max);
+        }
+    }
+    if let Some(b) = blt3 {
+        let np = b.settings.rule.len();
+        for (e, &c) in map.blt3.iter().enumerate() {
+            // [σxx, σyy, σxy, σyz, σzx], the shear resultants [Qxz, Qyz] over h
+            let (q, h) = (b.shear(e), b.thickness[e]);
+            let point = |p: usize| {
+                let s = b.stress(e, p);
+                [s[0], s[1], s[2], q[1] / h, q[0] / h]
+            };
+            vm[c] = (0..np).map(|p| shell_von_mises(&point(p))).fold(0.0, f64::max);
         }
     }
     out.push(("von_mises", vm));

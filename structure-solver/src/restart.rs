@@ -4,17 +4,19 @@
 //!
 //! The state of an `FeModel`: positions `x`, nodal rotation matrices `rotations`, accumulated
 //! spins `spins` (BT4 shells read their increments from them), the J2 state of every element
-//! `material`, and for BT4 shells per point the stresses, equivalent plastic strain and
-//! hourglass stresses (`bt4.*`), and the topology (`topology.*`: version, node and element
-//! ids, reference positions, the user's fixed dofs, and the element list with the element
-//! each was copied from), so that a restart after a change at run time first rebuilds the
-//! changed model from the one its case builds. A restart restores all of it, so it
-//! reproduces the run bitwise.
+//! `material`, for BT4 shells per point the stresses, equivalent plastic strain and
+//! hourglass stresses (`bt4.*`), for BLT3 shells per point the stresses and equivalent
+//! plastic strain and per element the shear resultants (`blt3.*`), and the topology
+//! (`topology.*`: version, node and element ids, reference positions, the user's fixed dofs,
+//! and the element list with the element each was copied from), so that a restart after a
+//! change at run time first rebuilds the changed model from the one its case builds. A
+//! restart restores all of it, so it reproduces the run bitwise.
 
 use interface_protocol::io::checkpoint::Checkpoint;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::assembly::{FeModel, TopologyRecord};
+use crate::elements::blt3::Blt3State;
 use crate::elements::bt4::Bt4State;
 use crate::model::Model;
 use crate::time::Dynamics;
@@ -101,6 +103,12 @@ pub fn save_state(model: &FeModel, ck: &mut Checkpoint) -> anyhow::Result<()> {
         ck.put("bt4.plastic_strain", s.alpha.clone())?;
         ck.put("bt4.hourglass", s.hourglass.clone())?;
     }
+    if let Some(b) = model.blt3() {
+        let s = b.state();
+        ck.put("blt3.stress", s.stress.clone())?;
+        ck.put("blt3.plastic_strain", s.alpha.clone())?;
+        ck.put("blt3.shear", s.shear.clone())?;
+    }
     Ok(())
 }
 
@@ -130,8 +138,19 @@ pub fn restore_state(model: &mut FeModel, ck: &Checkpoint) -> anyhow::Result<()>
         }
         None => None,
     };
+    let blt3 = match model.blt3() {
+        Some(b) => {
+            let s = b.state();
+            Some(Blt3State {
+                stress: sized(ck, "blt3.stress", s.stress.len())?.to_vec(),
+                alpha: sized(ck, "blt3.plastic_strain", s.alpha.len())?.to_vec(),
+                shear: sized(ck, "blt3.shear", s.shear.len())?.to_vec(),
+            })
+        }
+        None => None,
+    };
     model
-        .restore_committed(&x, &r, &spins, material, bt4)
+        .restore_committed(&x, &r, &spins, material, bt4, blt3)
         .map_err(|e| anyhow::anyhow!("checkpoint at step {}: {e}", ck.step))
 }
 

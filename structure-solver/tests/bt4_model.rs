@@ -172,7 +172,8 @@ fn static_and_implicit_solves_refuse_bt4() {
     let mut im = Implicit::new(&mut fe, ImplicitScheme::Midpoint, 0.0, vec![0.0; n], None);
     let err = im.step(&mut fe, 1e-6, None).unwrap_err();
     assert!(matches!(err, ImplicitError::NoTangent), "{err}");
-    // triangles cannot be BT4
-    let err = FeModel::new(&mesh.to_triangles(), |_| Part::Bt4(SEC, None)).unwrap_err();
-    assert!(err.to_string().contains("BT4"), "{err}");
+    // lines cannot be explicit shells
+    let line = generate::line([0.0; 3], [1.0, 0.0, 0.0], 2);
+    let err = FeModel::new(&line, |_| Part::Bt4(SEC, None)).unwrap_err();
+    assert!(err.to_string().contains("explicit shell"), "{err}");
 }

@@ -257,14 +257,14 @@ fn semantic_errors_name_the_field_and_what_was_expected() {
                 "no set \"skin\"; known sets: all, u0, u1, v0, v1, x0, x1, y0, y1",
             ],
         ),
-        // BT4 on triangles
+        // a triangle element on quadrilaterals
         (
             plate,
-            "nx = 10, ny = 10 }",
-            "nx = 10, ny = 10, triangles = true }",
+            "element = \"bt4\"",
+            "element = \"dkt\"",
             &[
                 "structure.parts[0].element",
-                "bt4 needs quadrilaterals; cell 0 of set \"all\" is a tri3",
+                "dkt needs triangles; cell 0 of set \"all\" is a quad4",
             ],
         ),
         // a static run of explicit-only shells

@@ -108,7 +108,7 @@ fn strip_under_end_moment(part: Part) -> f64 {
     }
     let s = NewtonSettings::default();
     load_steps(&mut fe, &[1.0], &s, |_, _| {}).unwrap();
-    let map = CellMap { elements: (0..8).collect(), bt4: vec![], n_cells: 8 };
+    let map = CellMap { elements: (0..8).collect(), bt4: vec![], blt3: vec![], n_cells: 8 };
     let fields = cell_fields(&fe, &map);
     let vm = &fields.iter().find(|(n, _)| *n == "von_mises").unwrap().1;
     vm[0] / (6.0 * m / (b * h * h))
@@ -144,7 +144,7 @@ fn beam_under_tension_and_end_couples_gives_the_corner_stress() {
         fe.point_load(end, c, v, Curve::Linear);
     }
     load_steps(&mut fe, &[1.0], &NewtonSettings::default(), |_, _| {}).unwrap();
-    let map = CellMap { elements: (0..4).collect(), bt4: vec![], n_cells: 4 };
+    let map = CellMap { elements: (0..4).collect(), bt4: vec![], blt3: vec![], n_cells: 4 };
     let fields = cell_fields(&fe, &map);
     let vm = &fields.iter().find(|(n, _)| *n == "von_mises").unwrap().1;
     let exact = p / (b * h) + 6.0 * my / (b * h * h) + 6.0 * mz / (h * b * b);

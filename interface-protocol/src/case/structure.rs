@@ -55,7 +55,9 @@
 //! # default every cell of the mesh's highest dimension: cells of a lower one in no part, as
 //! # the boundary lines of a gmsh surface, only define sets). Without parts, one part of
 //! # `element` (default bt4), `material` and `thickness` covers the mesh.
-//! #   bt4    explicit one-point shell, quadrilaterals (one material for all bt4 parts)
+//! #   bt4    explicit one-point shell: BT4 on quadrilaterals, BLT3 on triangles (the cell
+//! #          decides, so a triangle or mixed mesh runs as one explicit part); any number of
+//! #          materials; J2 bt4 parts share one `points`, elastic ones take it
 //! #   mitc4  shell, quadrilaterals      dkt   shell, triangles
 //! #   shell  mitc4 or dkt by cell kind  beam  2-node beam      tet4  solid
 //! # J2 shells integrate `points` Gauss points through the thickness (default 5).
@@ -295,7 +297,7 @@ pub struct StructureMaterial {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ElementType {
-    /// Explicit one-point Belytschko-Tsay shell on quadrilaterals.
+    /// Explicit one-point shell: Belytschko-Tsay on quadrilaterals, BLT3 on triangles.
     Bt4,
     /// MITC4 shell on quadrilaterals.
     Mitc4,

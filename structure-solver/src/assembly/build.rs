@@ -1,11 +1,15 @@
-//! A model from mesh cells: each cell becomes the element its `Part` says (BT4 shells gathered
-//! into one blocked part), the dofs without stiffness are constrained, and the lumped mass and
-//! element bound of the critical step follow the chosen rotary inertia.
+//! A model from mesh cells: each cell becomes the element its `Part` says (explicit shells
+//! gathered into one blocked BT4 part of the quadrilaterals and one BLT3 part of the
+//! triangles, each element with its material), the dofs without stiffness are constrained,
+//! and the lumped mass and element bound of the critical step follow the chosen rotary
+//! inertia.
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::explicit_shells::ExplicitShells;
 use super::stable_step::{characteristic_length, ElementBound};
-use super::{gather, AssemblyError, Bt4Part, FeModel, Part, State};
+use super::{gather, AssemblyError, FeModel, Part, State};
+use crate::elements::blt3::{Blt3, Blt3Settings};
 use crate::elements::bt4::{Bt4, Bt4Settings};
 use crate::elements::{Element, ElementKind, RotaryInertia};
 use crate::material::{Elastic, ThicknessRule, J2};
@@ -18,26 +22,13 @@ impl FeModel {
         let x0: Vec<Vector3<f64>> = mesh.nodes.iter().map(|p| Vector3::from(*p)).collect();
         let mut elements = Vec::with_capacity(mesh.cells.len());
         let mut element_cell = Vec::with_capacity(mesh.cells.len());
-        let mut bt4_conn = Vec::new();
-        let mut bt4_h = Vec::new();
-        let mut bt4_material: Option<(J2, usize)> = None;
+        let mut shells = ShellCells::default();
         for (ci, cell) in mesh.cells.iter().enumerate() {
             if let Some(&bad) = cell.nodes.iter().find(|&&n| n >= nn) {
                 return Err(AssemblyError::NodeRange { node: bad, n: nn });
             }
-            if let (CellKind::Quad4, Part::Bt4(s, y)) = (cell.kind, part(ci)) {
-                let j2 = J2 {
-                    elastic: Elastic { e: s.e, nu: s.nu, rho: s.rho },
-                    sigma_y: y.map_or(f64::INFINITY, |y| y.sigma_y),
-                    h: y.map_or(0.0, |y| y.hardening),
-                };
-                let mat = (j2, y.map_or(5, |y| y.points));
-                if *bt4_material.get_or_insert(mat) != mat {
-                    return Err(AssemblyError::Bt4Material { cell: ci });
-                }
-                let nd = &cell.nodes;
-                bt4_conn.push([nd[0], nd[1], nd[2], nd[3]].map(|n| n as u32));
-                bt4_h.push(s.h);
+            if let (CellKind::Quad4 | CellKind::Tri3, Part::Bt4(s, y)) = (cell.kind, part(ci)) {
+                shells.push(ci, &cell.nodes, s, y)?;
                 continue;
             }
             let p = gather(&x0, &cell.nodes);
@@ -69,7 +60,7 @@ impl FeModel {
                 (kind, p) => {
                     let part = match p {
                         Part::Shell(_) | Part::ShellJ2(..) => "a shell section",
-                        Part::Bt4(..) => "a BT4 shell (quadrilaterals only)",
+                        Part::Bt4(..) => "an explicit shell (triangles or quadrilaterals)",
                         Part::Beam(..) | Part::BeamJ2(..) => "a beam section",
                         Part::Solid(_) => "a solid material",
                     };
@@ -87,24 +78,10 @@ impl FeModel {
                 constrained[6 * n..6 * n + k].fill(false);
             }
         }
-        for c in &bt4_conn {
-            for &n in c {
-                constrained[6 * n as usize..6 * n as usize + 6].fill(false);
-            }
+        for n in shells.quads.conn.iter().flatten().chain(shells.triangles.conn.iter().flatten()) {
+            constrained[6 * *n as usize..6 * *n as usize + 6].fill(false);
         }
-        let bt4 = bt4_material.map(|(material, points)| {
-            let settings = Bt4Settings {
-                rule: ThicknessRule::gauss(points),
-                rotary: RotaryInertia::Physical,
-                ..Bt4Settings::default()
-            };
-            Bt4Part {
-                shells: Bt4::new(bt4_conn, bt4_h, material, settings),
-                x: x0.iter().map(|p| [p.x, p.y, p.z]).collect(),
-                du: vec![0.0; 6 * nn],
-                evaluated: false,
-            }
-        });
+        let explicit = shells.build(&x0);
         let mut state_offsets = vec![0];
         for e in &elements {
             state_offsets.push(state_offsets[state_offsets.len() - 1] + e.n_state());
@@ -115,7 +92,11 @@ impl FeModel {
             spin_sum: vec![Vector3::zeros(); nn],
             material: vec![0.0; state_offsets[elements.len()]],
         };
-        let topology = super::topology::Topology::built(nn, mesh.cells.len(), &element_cell);
+        let topology = super::topology::Topology::built(
+            nn,
+            &mesh.cells.iter().map(|c| c.nodes.len()).collect::<Vec<_>>(),
+            &element_cell,
+        );
         let mut m = FeModel {
             x0,
             trial: state.clone(),
@@ -124,7 +105,7 @@ impl FeModel {
             state_offsets,
             cells: mesh.cells.iter().map(|c| c.nodes.clone()).collect(),
             element_cell,
-            bt4,
+            explicit,
             rotary: RotaryInertia::Physical,
             mass: vec![],
             node_mass: vec![],
@@ -185,10 +166,8 @@ impl FeModel {
             bound.push(ElementBound { dt, length: characteristic_length(e.kind, &x) });
         }
         self.element_bound = bound;
-        if let Some(b) = &mut self.bt4 {
-            b.shells.settings.rotary = rotary;
-            let x0: Vec<[f64; 3]> = self.x0.iter().map(|p| [p.x, p.y, p.z]).collect();
-            b.shells.lumped_mass(&x0, &mut mass);
+        if let Some(b) = &mut self.explicit {
+            b.set_rotary_inertia(rotary, &self.x0, &mut mass);
         }
         self.node_mass = mass;
         self.reduce_mass();
@@ -216,5 +195,90 @@ impl FeModel {
                 self.mass[d + c] = m[(c, c)];
             }
         }
+    }
+}
+
+/// The cells of one family of explicit shells: connectivity, thickness, material index.
+#[derive(Debug, Default)]
+struct Family<const K: usize> {
+    conn: Vec<[u32; K]>,
+    h: Vec<f64>,
+    material_of: Vec<u16>,
+}
+
+/// The explicit shell cells of a model as they are met: the two families, their materials
+/// (distinct, in order of appearance) and the thickness points of the first J2 cell.
+#[derive(Debug, Default)]
+struct ShellCells {
+    quads: Family<4>,
+    triangles: Family<3>,
+    materials: Vec<J2>,
+    points: Option<(usize, usize)>,
+}
+
+impl ShellCells {
+    fn push(
+        &mut self,
+        cell: usize,
+        nodes: &[usize],
+        s: crate::elements::ShellSection,
+        y: Option<crate::elements::ShellYield>,
+    ) -> Result<(), AssemblyError> {
+        let j2 = J2 {
+            elastic: Elastic { e: s.e, nu: s.nu, rho: s.rho },
+            sigma_y: y.map_or(f64::INFINITY, |y| y.sigma_y),
+            h: y.map_or(0.0, |y| y.hardening),
+        };
+        if !(s.h.is_finite() && s.h > 0.0) {
+            return Err(AssemblyError::ShellThickness { cell, h: s.h });
+        }
+        if let Some(y) = y {
+            let (first, first_points) = *self.points.get_or_insert((cell, y.points));
+            if y.points != first_points {
+                return Err(AssemblyError::ShellPoints {
+                    cell,
+                    points: y.points,
+                    first,
+                    first_points,
+                });
+            }
+        }
+        let m = match self.materials.iter().position(|m| *m == j2) {
+            Some(m) => m,
+            None => {
+                self.materials.push(j2);
+                self.materials.len() - 1
+            }
+        };
+        let m = u16::try_from(m).map_err(|_| AssemblyError::ShellMaterials { cell })?;
+        let n = |i: usize| nodes[i] as u32;
+        if nodes.len() == 4 {
+            self.quads.conn.push([n(0), n(1), n(2), n(3)]);
+            self.quads.h.push(s.h);
+            self.quads.material_of.push(m);
+        } else {
+            self.triangles.conn.push([n(0), n(1), n(2)]);
+            self.triangles.h.push(s.h);
+            self.triangles.material_of.push(m);
+        }
+        Ok(())
+    }
+
+    /// The BT4 and BLT3 parts (physical rotary inertia until the model sets its own).
+    fn build(self, x0: &[Vector3<f64>]) -> Option<ExplicitShells> {
+        let rule = ThicknessRule::gauss(self.points.map_or(5, |p| p.1));
+        let (q, t, mats) = (self.quads, self.triangles, self.materials);
+        let rotary = RotaryInertia::Physical;
+        let quads = (!q.conn.is_empty()).then(|| {
+            let settings = Bt4Settings { rule: rule.clone(), rotary, ..Default::default() };
+            Bt4::with_materials(q.conn, q.h, mats.clone(), q.material_of, settings)
+                .expect("one thickness and a listed material per element")
+        });
+        let triangles = (!t.conn.is_empty()).then(|| {
+            let settings = Blt3Settings { rule, rotary, ..Default::default() };
+            Blt3::with_materials(t.conn, t.h, mats, t.material_of, settings)
+                .expect("one positive thickness and a listed material per element")
+        });
+        ExplicitShells::new(quads, triangles, x0)
     }
 }

@@ -68,17 +68,8 @@ impl Model for FeModel {
     fn internal_force(&mut self, f: &mut [f64]) {
         f.fill(0.0);
         self.element_forces(f);
-        if let Some(b) = &mut self.bt4 {
-            // BT4 reads the end positions and the step's increment (translations and summed
-            // spins since the last commit).
-            let (t, c) = (&self.trial, &self.committed);
-            for n in 0..t.x.len() {
-                let (dx, dw) = (t.x[n] - c.x[n], t.spin_sum[n] - c.spin_sum[n]);
-                b.x[n] = [t.x[n].x, t.x[n].y, t.x[n].z];
-                b.du[6 * n..6 * n + 6].copy_from_slice(&[dx.x, dx.y, dx.z, dw.x, dw.y, dw.z]);
-            }
-            b.shells.internal_force(&b.x, &b.du, f);
-            b.evaluated = true;
+        if let Some(b) = &mut self.explicit {
+            b.internal_force(&self.trial, &self.committed, f);
         }
         if !self.rigid.is_empty() {
             self.fint_full.clear();
@@ -247,22 +238,21 @@ impl Model for FeModel {
 
     fn commit(&mut self) {
         self.committed.clone_from(&self.trial);
-        if let Some(b) = self.bt4.as_mut().filter(|b| b.evaluated) {
-            b.shells.commit();
-            b.evaluated = false;
+        if let Some(b) = &mut self.explicit {
+            b.commit();
         }
     }
 
     fn revert(&mut self) {
         self.fint_valid = false;
         self.trial.clone_from(&self.committed);
-        if let Some(b) = &mut self.bt4 {
+        if let Some(b) = &mut self.explicit {
             b.evaluated = false;
         }
     }
 
     fn has_tangent(&self) -> bool {
-        self.bt4.is_none()
+        self.explicit.is_none()
     }
 
     /// The topology version (`topology`): 1 as built, increased by every run-time change.
@@ -283,7 +273,7 @@ impl Model for FeModel {
 }
 
 impl FeModel {
-    /// The tangent of the elements; BT4 shells add nothing (`has_tangent` is then `false`).
+    /// The tangent of the elements; explicit shells add nothing (`has_tangent` is then `false`).
     pub(super) fn element_tangent(&self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
         out.clear();
         let pc = self.cell_pressure(t);

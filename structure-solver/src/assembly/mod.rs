@@ -4,7 +4,8 @@
 //! prescribed and skew-symmetry dofs and their reduction), `rigid_bodies` (rigid bodies and
 //! links: slaves on masters, the reduction `Tᵀ f`, `Tᵀ K T`), `loads` (time curves, point
 //! loads, pressure, gravity, the coupling's nodal array), `forces` (the `Model` the
-//! integrators call; `element_forces` its element loop), `stable_step` (the element bound of the critical step at the current
+//! integrators call; `element_forces` its element loop, `explicit_shells` the BT4 and BLT3
+//! shells), `stable_step` (the element bound of the critical step at the current
 //! configuration), `state` (the committed state checkpoints hold).
 //!
 //! Six dofs per node `[ux, uy, uz, θx, θy, θz]`; rotations are stored as matrices and updated
@@ -27,12 +28,14 @@
 //! checkpoint holds of it, and the rebuild of a changed model at a restart).
 //!
 //! Parts: elastic shells, J2 shells integrated through the thickness (MITC4, DKT), beams,
-//! tets, and the explicit-only one-point BT4 shells, which have no tangent (static and
-//! implicit solvers return an error for a model holding them).
+//! tets, and the explicit-only one-point shells (`explicit_shells`: BT4 on quadrilaterals,
+//! BLT3 on triangles, any number of materials), which have no tangent (static and implicit
+//! solvers return an error for a model holding them).
 
 mod build;
 mod constraints;
 mod element_forces;
+mod explicit_shells;
 mod forces;
 mod loads;
 mod rigid_bodies;
@@ -44,6 +47,7 @@ mod topology_record;
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::elements::blt3::Blt3;
 use crate::elements::bt4::Bt4;
 pub use crate::elements::RotaryInertia;
 use crate::elements::{BeamSection, BeamYield, Element, ShellSection, ShellYield};
@@ -52,6 +56,7 @@ use crate::mesh::CellKind;
 use crate::rigid::RigidBody;
 
 use constraints::SkewNode;
+use explicit_shells::ExplicitShells;
 pub use loads::Curve;
 pub use topology::{IdMap, Store, Topology, TopologyError};
 pub use topology_change::NewNode;
@@ -63,9 +68,12 @@ pub enum Part {
     Shell(ShellSection),
     /// A shell of a J2 material integrated through the thickness (MITC4 or DKT).
     ShellJ2(ShellSection, ShellYield),
-    /// A one-point Belytschko-Tsay shell (`elements::bt4`), elastic or J2 at the thickness
-    /// points of the yield (5 Gauss points when elastic): explicit only, it has no tangent,
-    /// so static and implicit solves refuse a model holding one. One material per model.
+    /// A one-point explicit shell, elastic or J2 at the thickness points of the yield: the
+    /// Belytschko-Tsay quadrilateral (`elements::bt4`) on a quadrilateral, the BLT3 triangle
+    /// (`elements::blt3`) on a triangle. Explicit only, it has no tangent, so static and
+    /// implicit solves refuse a model holding one. Parts may differ in material; the J2 ones
+    /// share one number of thickness points, which the elastic ones take (5 when all are
+    /// elastic; a Gauss rule of two or more points integrates an elastic section exactly).
     Bt4(ShellSection, Option<ShellYield>),
     /// A beam whose local `y` axis is `up` projected normal to it.
     Beam(BeamSection, [f64; 3]),
@@ -81,8 +89,15 @@ pub enum AssemblyError {
     Mismatch { cell: usize, kind: CellKind, part: &'static str },
     #[error("node {node} out of range ({n} nodes)")]
     NodeRange { node: usize, n: usize },
-    #[error("cell {cell}: BT4 shells of one model share one material and thickness rule")]
-    Bt4Material { cell: usize },
+    #[error(
+        "cell {cell}: a J2 explicit shell of {points} thickness points, where those of cell \
+         {first} have {first_points}; J2 bt4 parts share one number of points"
+    )]
+    ShellPoints { cell: usize, points: usize, first: usize, first_points: usize },
+    #[error("cell {cell}: more than {max} explicit shell materials", max = u16::MAX as usize + 1)]
+    ShellMaterials { cell: usize },
+    #[error("cell {cell}: shell thickness {h}, expected a positive finite value")]
+    ShellThickness { cell: usize, h: f64 },
     #[error("symmetry plane: the normal {normal:?} is not a finite non-zero vector")]
     BadNormal { normal: [f64; 3] },
     #[error("symmetry plane: node {node} belongs to a rigid body")]
@@ -115,8 +130,8 @@ pub struct FeModel {
     cells: Vec<Vec<usize>>,
     /// Mesh cell of each element.
     element_cell: Vec<usize>,
-    /// The explicit-only BT4 shells, if any.
-    bt4: Option<Bt4Part>,
+    /// The explicit-only one-point shells, if any.
+    explicit: Option<ExplicitShells>,
     rotary: RotaryInertia,
     /// Lumped mass of the model's free dofs (rigid bodies reduced to their masters).
     mass: Vec<f64>,
@@ -153,17 +168,6 @@ pub struct FeModel {
     element_bound: Vec<stable_step::ElementBound>,
     /// User ids of nodes and cells, where each cell's element is stored, the version.
     topology: topology::Topology,
-}
-
-/// The BT4 shells of a model with their work arrays.
-#[derive(Debug, Clone)]
-struct Bt4Part {
-    shells: Bt4,
-    /// Positions and the increment since the last commit, in the layout `Bt4` reads.
-    x: Vec<[f64; 3]>,
-    du: Vec<f64>,
-    /// A trial state was computed since the last commit or revert.
-    evaluated: bool,
 }
 
 fn gather<T: Copy>(all: &[T], nodes: &[usize]) -> Vec<T> {
@@ -215,8 +219,14 @@ impl FeModel {
         &self.committed.spin_sum
     }
 
-    /// The explicit BT4 shells, if any (their state and output fields).
+    /// The explicit BT4 shells (the quadrilaterals of `Part::Bt4`), if any (their state and
+    /// output fields).
     pub fn bt4(&self) -> Option<&Bt4> {
-        self.bt4.as_ref().map(|b| &b.shells)
+        self.explicit.as_ref().and_then(|b| b.quads.as_ref())
+    }
+
+    /// The explicit BLT3 shells (the triangles of `Part::Bt4`), if any.
+    pub fn blt3(&self) -> Option<&Blt3> {
+        self.explicit.as_ref().and_then(|b| b.triangles.as_ref())
     }
 }

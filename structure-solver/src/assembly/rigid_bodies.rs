@@ -105,9 +105,8 @@ impl FeModel {
         self.body_of.push(None);
         self.skew_of.push(None);
         self.slave.push(false);
-        if let Some(b) = &mut self.bt4 {
-            b.x.push([p.x, p.y, p.z]);
-            b.du.extend([0.0; 6]);
+        if let Some(b) = &mut self.explicit {
+            b.add_node(&p);
         }
     }
 

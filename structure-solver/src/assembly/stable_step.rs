@@ -4,7 +4,7 @@
 //! reference configuration; every step it is scaled by how the element's characteristic
 //! length changed, `ρ = L(x)/L(X)`: by `ρ` for tets (a wave speed over a length), by
 //! `min(ρ, ρ²)` for shells and beams (their bending frequencies go as `1/L²`), so a shrinking
-//! element shortens the step. BT4 shells recompute their own geometric bound.
+//! element shortens the step. The explicit shells give their own (`ExplicitShells::stable_dt`).
 
 use nalgebra::Vector3;
 
@@ -45,7 +45,7 @@ pub(super) fn characteristic_length(kind: ElementKind, x: &[Vector3<f64>]) -> f6
 
 impl FeModel {
     /// The element bound of the critical step at the current configuration (the trial
-    /// positions; BT4 shells at the positions of their last internal force).
+    /// positions; explicit shells at the positions of their last internal force).
     pub(super) fn current_stable_dt(&self) -> f64 {
         let x = &self.trial.x;
         let mut dt = f64::INFINITY;
@@ -64,8 +64,8 @@ impl FeModel {
             };
             dt = dt.min(b.dt * scale);
         }
-        if let Some(b) = &self.bt4 {
-            dt = dt.min(b.shells.stable_dt(&b.x));
+        if let Some(b) = &self.explicit {
+            dt = dt.min(b.stable_dt());
         }
         dt
     }

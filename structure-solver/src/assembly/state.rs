@@ -6,7 +6,7 @@ use super::FeModel;
 
 impl FeModel {
     /// Restores a committed state (configuration, accumulated spins, the material state of
-    /// the elements as `element_state` reads it, concatenated, and the BT4 state) and commits
+    /// the elements as `element_state` reads it, concatenated, and the BT4 and BLT3 states) and commits
     /// it, so that a run resumes bitwise; refuses arrays of another model.
     pub fn restore_committed(
         &mut self,
@@ -15,6 +15,7 @@ impl FeModel {
         spins: &[Vector3<f64>],
         material: &[f64],
         bt4: Option<crate::elements::bt4::Bt4State>,
+        blt3: Option<crate::elements::blt3::Blt3State>,
     ) -> Result<(), String> {
         let nn = self.x0.len();
         if x.len() != nn || r.len() != nn || spins.len() != nn {
@@ -27,24 +28,12 @@ impl FeModel {
                 self.committed.material.len()
             ));
         }
-        match (&mut self.bt4, bt4) {
-            (Some(b), Some(s)) => {
-                let have = b.shells.state();
-                if (s.stress.len(), s.alpha.len(), s.hourglass.len())
-                    != (have.stress.len(), have.alpha.len(), have.hourglass.len())
-                {
-                    return Err("a BT4 state of another mesh or thickness rule".into());
-                }
-                b.shells.set_state(s);
-                b.evaluated = false;
-                // the configuration the shells' stable step reads
-                for (b, p) in b.x.iter_mut().zip(x) {
-                    *b = [p.x, p.y, p.z];
-                }
+        match &mut self.explicit {
+            Some(b) => b.restore(bt4, blt3, x)?,
+            None if bt4.is_some() || blt3.is_some() => {
+                return Err("the state has explicit shells, the model has none".into())
             }
-            (None, None) => {}
-            (Some(_), None) => return Err("the model has BT4 shells, the state has none".into()),
-            (None, Some(_)) => return Err("the state has BT4 shells, the model has none".into()),
+            None => {}
         }
         let s = &mut self.trial;
         s.x.copy_from_slice(x);

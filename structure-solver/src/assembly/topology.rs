@@ -83,8 +83,10 @@ impl IdMap {
 pub enum Store {
     /// `FeModel::elements()[i]`.
     Element(usize),
-    /// Element `i` of the BT4 part.
+    /// Element `i` of the BT4 shells (quadrilaterals of the explicit shell parts).
     Bt4(usize),
+    /// Element `i` of the BLT3 shells (their triangles).
+    Blt3(usize),
 }
 
 /// Ids, element storage and version of a model's topology.
@@ -99,20 +101,25 @@ pub struct Topology {
 }
 
 impl Topology {
-    /// The topology of a built model: `n_nodes` nodes, `n_cells` cells, `element_cell[i]` the
-    /// cell of element `i`, the other cells BT4 shells in cell order.
-    pub(super) fn built(n_nodes: usize, n_cells: usize, element_cell: &[usize]) -> Self {
+    /// The topology of a built model: `n_nodes` nodes, cells of `cell_nodes[c]` nodes,
+    /// `element_cell[i]` the cell of element `i`, the other cells explicit shells in cell
+    /// order (BT4 on quadrilaterals, BLT3 on triangles).
+    pub(super) fn built(n_nodes: usize, cell_nodes: &[usize], element_cell: &[usize]) -> Self {
+        let n_cells = cell_nodes.len();
         let mut store = vec![None; n_cells];
         for (i, &c) in element_cell.iter().enumerate() {
             store[c] = Some(Store::Element(i));
         }
-        let mut n_bt4 = 0;
+        let (mut n_bt4, mut n_blt3) = (0, 0);
         let store = store
             .into_iter()
-            .map(|s| {
+            .zip(cell_nodes)
+            .map(|(s, &n)| {
                 s.unwrap_or_else(|| {
-                    n_bt4 += 1;
-                    Store::Bt4(n_bt4 - 1)
+                    let (count, store): (&mut usize, fn(usize) -> Store) =
+                        if n == 4 { (&mut n_bt4, Store::Bt4) } else { (&mut n_blt3, Store::Blt3) };
+                    *count += 1;
+                    store(*count - 1)
                 })
             })
             .collect();
@@ -167,6 +174,8 @@ pub enum TopologyError {
     Reference { element: u64, node: u64, got: [f64; 3], expected: [f64; 3] },
     #[error("node {node}: {field} is not finite")]
     NotFinite { node: u64, field: &'static str },
+    #[error("element {element}: copying a 3-node explicit shell (BLT3) is not supported yet")]
+    Unsupported { element: u64 },
     #[error("topology record: {0}")]
     Record(String),
 }

@@ -118,6 +118,9 @@ impl FeModel {
         let id = |n: usize| self.topology.nodes.id(n).unwrap_or(n as u64);
         let element = self.topology.elements.id(c).unwrap_or(c as u64);
         let own = &self.cells[c];
+        if matches!(self.topology.store[c], Store::Blt3(_)) {
+            return Err(TopologyError::Unsupported { element });
+        }
         if slots.len() != own.len() {
             return Err(TopologyError::NodeCount {
                 element,
@@ -168,11 +171,13 @@ impl FeModel {
                 (Store::Element(self.elements.len() - 1), rotations)
             }
             Store::Bt4(j) => {
-                let b = self.bt4.as_mut().expect("a BT4 cell has its part");
+                let b = self.explicit.as_mut().and_then(|e| e.quads.as_mut());
+                let b = b.expect("a BT4 cell has its part");
                 let conn = [0, 1, 2, 3].map(|k| slots[k] as u32);
-                let k = b.shells.push_copy(j, conn).expect("a BT4 cell's shell exists");
+                let k = b.push_copy(j, conn).expect("a BT4 cell's shell exists");
                 (Store::Bt4(k), true)
             }
+            Store::Blt3(_) => unreachable!("check_copy refuses BLT3 copies"),
         };
         let k = if rotations { 6 } else { 3 };
         for &n in &slots {

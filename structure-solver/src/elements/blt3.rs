@@ -10,19 +10,27 @@
 //! and global rotation increments) of the step; strain increments in the mid-step geometry
 //! `x^{n+1} - Δu/2` (where a rigid rotation's chord is a pure spin), the hypoelastic
 //! plane-stress update at the points of a [`ThicknessRule`] with the J2 plane-stress return
-//! (`J2::return_plane_stress`, at most `newton` updates), the elastic transverse shear as
-//! resultants (`κ G h`), and the nodal forces `A Bᵀ s` in the end geometry. Stresses live in
+//! (`J2::return_plane_stress`: `newton` Newton updates, then the safeguarded fallback for
+//! points still outside `return_tol`, as `bt4`), the elastic transverse shear as resultants
+//! (`κ G h`), and the nodal forces `A Bᵀ s` in the end geometry (`kernel`). Stresses live in
 //! the element frame, so a rigid rotation carries them unchanged. State is double-buffered:
-//! a step reads the committed state and writes the trial state; `commit` swaps them.
+//! a step reads the committed state and writes the trial state; `commit` swaps them. The loop
+//! (`forces`) runs over threads, bitwise independent of their number. Each element has its
+//! own material (an index into the part's list).
 
+mod forces;
+mod kernel;
 mod strain;
 
+pub use forces::ELEMENTS_PER_TASK;
 pub use strain::{frame, rows, Frame, Rows, N_DOF};
 
+use rayon::prelude::*;
+
 use super::add_node_masses;
-use super::section::{RotaryInertia, SHEAR_FACTOR};
+use super::section::RotaryInertia;
 use crate::material::{ThicknessRule, J2};
-use strain::{apply, dot};
+use kernel::max_frequency_squared;
 
 /// Stress components per thickness point: `[σxx, σyy, σxy]`.
 pub const N_STRESS: usize = 3;
@@ -33,15 +41,23 @@ pub const N_SHEAR: usize = 3;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Blt3Settings {
     pub rule: ThicknessRule,
-    /// Newton updates of the plane-stress return.
+    /// Plain Newton updates of the plane-stress return.
     pub newton: usize,
+    /// Tolerance of the plane-stress return, `|f| <= tol κ²`: points still outside it after
+    /// `newton` updates continue with the safeguarded fallback (0: exactly `newton` updates).
+    pub return_tol: f64,
     /// Lumping of rotary inertia.
     pub rotary: RotaryInertia,
 }
 
 impl Default for Blt3Settings {
     fn default() -> Self {
-        Blt3Settings { rule: ThicknessRule::gauss(5), newton: 3, rotary: RotaryInertia::Scaled }
+        Blt3Settings {
+            rule: ThicknessRule::gauss(5),
+            newton: 3,
+            return_tol: 1e-10,
+            rotary: RotaryInertia::Scaled,
+        }
     }
 }
 
@@ -56,15 +72,21 @@ pub struct Blt3State {
     pub shear: Vec<f64>,
 }
 
-/// A part of BLT3 shells: connectivity, thickness per element, one material.
+/// A part of BLT3 shells: connectivity, thickness and material per element.
 #[derive(Debug, Clone)]
 pub struct Blt3 {
     pub conn: Vec<[u32; 3]>,
     pub thickness: Vec<f64>,
-    pub material: J2,
     pub settings: Blt3Settings,
+    materials: Vec<J2>,
+    /// Index into `materials` per element.
+    material_of: Vec<u16>,
     committed: Blt3State,
     trial: Blt3State,
+    work: forces::Work,
+    /// Each element's step bound and characteristic length at the reference configuration
+    /// (`set_reference`).
+    reference: Vec<[f64; 2]>,
 }
 
 /// Why a part cannot be built.
@@ -74,37 +96,95 @@ pub enum Blt3Error {
     Thickness { conn: usize, thickness: usize },
     #[error("element {element}: thickness {h} must be positive and finite")]
     BadThickness { element: usize, h: f64 },
+    #[error("{conn} triangles but {got} material indices: one per element")]
+    MaterialCount { conn: usize, got: usize },
+    #[error("element {element} has material {index}, expected an index below {n}")]
+    MaterialIndex { element: usize, index: usize, n: usize },
+    #[error("the list of materials is empty")]
+    NoMaterial,
+    #[error("more than {max} materials", max = u16::MAX as usize + 1)]
+    TooManyMaterials,
 }
 
 impl Blt3 {
-    /// A part; `thickness` per element.
+    /// A part of one material; `thickness` per element.
     pub fn new(
         conn: Vec<[u32; 3]>,
         thickness: Vec<f64>,
         material: J2,
         settings: Blt3Settings,
     ) -> Result<Self, Blt3Error> {
-        if conn.len() != thickness.len() {
-            return Err(Blt3Error::Thickness { conn: conn.len(), thickness: thickness.len() });
+        let ne = conn.len();
+        Self::with_materials(conn, thickness, vec![material], vec![0; ne], settings)
+    }
+
+    /// A part of several materials: element `e` is of `materials[material_of[e]]`.
+    pub fn with_materials(
+        conn: Vec<[u32; 3]>,
+        thickness: Vec<f64>,
+        materials: Vec<J2>,
+        material_of: Vec<u16>,
+        settings: Blt3Settings,
+    ) -> Result<Self, Blt3Error> {
+        let ne = conn.len();
+        if thickness.len() != ne {
+            return Err(Blt3Error::Thickness { conn: ne, thickness: thickness.len() });
+        }
+        if material_of.len() != ne {
+            return Err(Blt3Error::MaterialCount { conn: ne, got: material_of.len() });
         }
         if let Some((element, &h)) =
             thickness.iter().enumerate().find(|(_, h)| !(h.is_finite() && **h > 0.0))
         {
             return Err(Blt3Error::BadThickness { element, h });
         }
-        let (ne, np) = (conn.len(), settings.rule.len());
+        if materials.is_empty() {
+            return Err(Blt3Error::NoMaterial);
+        }
+        if materials.len() > u16::MAX as usize + 1 {
+            return Err(Blt3Error::TooManyMaterials);
+        }
+        if let Some((element, &m)) =
+            material_of.iter().enumerate().find(|&(_, &m)| m as usize >= materials.len())
+        {
+            return Err(Blt3Error::MaterialIndex {
+                element,
+                index: m as usize,
+                n: materials.len(),
+            });
+        }
+        let np = settings.rule.len();
         let state = Blt3State {
             stress: vec![0.0; ne * np * N_STRESS],
             alpha: vec![0.0; ne * np],
             shear: vec![0.0; ne * N_SHEAR],
         };
-        Ok(Blt3 { conn, thickness, material, settings, committed: state.clone(), trial: state })
+        Ok(Blt3 {
+            conn,
+            thickness,
+            settings,
+            materials,
+            material_of,
+            committed: state.clone(),
+            trial: state,
+            work: forces::Work::default(),
+            reference: Vec::new(),
+        })
     }
 
     pub fn n_elements(&self) -> usize {
         self.conn.len()
     }
 
+    /// The material of element `e`.
+    pub fn material(&self, e: usize) -> &J2 {
+        &self.materials[self.material_of[e] as usize]
+    }
+
+    /// The materials of the part.
+    pub fn materials(&self) -> &[J2] {
+        &self.materials
+    }
     /// Committed state (for checkpoints).
     pub fn state(&self) -> &Blt3State {
         &self.committed
@@ -154,8 +234,8 @@ impl Blt3 {
 
     /// Adds the lumped mass (`ρ h A / 3` per node) and rotary inertia to a 6-per-node vector.
     pub fn lumped_mass(&self, x: &[[f64; 3]], mass: &mut [f64]) {
-        let rho = self.material.elastic.rho;
-        for (c, &h) in self.conn.iter().zip(&self.thickness) {
+        for (e, (c, &h)) in self.conn.iter().zip(&self.thickness).enumerate() {
+            let rho = self.material(e).elastic.rho;
             let a = frame(&c.map(|n| x[n as usize])).area;
             let m = rho * h * a / 3.0;
             let i = self.settings.rotary.of_node(m, h, a);
@@ -170,191 +250,72 @@ impl Blt3 {
     /// element's eigenvalues, which bound the assembled ones (Irons 1970), for any shape and
     /// rotary inertia; `tests/blt3_dynamics.rs` measures how close it is.
     pub fn stable_dt(&self, x: &[[f64; 3]]) -> f64 {
-        let mut dt = f64::INFINITY;
-        for (conn, &h) in self.conn.iter().zip(&self.thickness) {
-            let f = frame(&conn.map(|n| x[n as usize]));
-            let w2 = max_frequency_squared(&self.material, &self.settings, &f, h);
-            dt = dt.min(2.0 / w2.sqrt());
-        }
-        dt
+        (0..self.conn.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|e| self.element_stable_dt(e, x))
+            .reduce(|| f64::INFINITY, f64::min)
+    }
+
+    fn element_stable_dt(&self, e: usize, x: &[[f64; 3]]) -> f64 {
+        let f = frame(&self.conn[e].map(|n| x[n as usize]));
+        let w2 = max_frequency_squared(self.material(e), &self.settings, &f, self.thickness[e]);
+        2.0 / w2.sqrt()
+    }
+
+    /// Takes `x` as the reference configuration of [`Blt3::scaled_stable_dt`]: each element's
+    /// [`Blt3::stable_dt`] bound and characteristic length there (call again when the rotary
+    /// inertia changes).
+    pub fn set_reference(&mut self, x: &[[f64; 3]]) {
+        self.reference = (0..self.conn.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|e| [self.element_stable_dt(e, x), altitude(&self.conn[e].map(|n| x[n as usize]))])
+            .collect();
+    }
+
+    /// The element bound of the critical step at `x`, scaled from the reference one
+    /// (`set_reference`) by how each element's characteristic length `L = 2A / max side`
+    /// changed, `ρ = L(x)/L(X)`: `dt_e min(ρ, ρ²)` (bending frequencies go as `1/L²`,
+    /// membrane ones as `1/L`), so a shrinking or flattening element shortens the step
+    /// without the Gershgorin sum every step.
+    pub fn scaled_stable_dt(&self, x: &[[f64; 3]]) -> f64 {
+        assert_eq!(self.reference.len(), self.conn.len(), "set_reference before the step bound");
+        (0..self.conn.len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|e| {
+                let [dt, l0] = self.reference[e];
+                let rho = altitude(&self.conn[e].map(|n| x[n as usize])) / l0;
+                dt * rho.min(rho * rho)
+            })
+            .reduce(|| f64::INFINITY, f64::min)
+    }
+
+    /// Bytes of state and work arrays per element (double-buffered state, connectivity,
+    /// thickness, material index, reference bound, element forces, node incidence).
+    pub fn bytes_per_element(&self) -> f64 {
+        let s = &self.committed;
+        let state = 2 * 8 * (s.stress.len() + s.alpha.len() + s.shear.len());
+        let mesh = 12 * self.conn.len() + 8 * self.thickness.len() + 2 * self.material_of.len();
+        let bytes = state + mesh + 16 * self.reference.len() + self.work.bytes();
+        bytes as f64 / self.conn.len().max(1) as f64
     }
 
     /// Adds the internal forces (6 per node, global frame) of the step with end positions
-    /// `x_end` and increment `du` (6 per node) to `f`, writing the trial state.
+    /// `x_end` and increment `du` (6 per node) to `f`, writing the trial state. Runs over the
+    /// threads of the current rayon pool; the result does not depend on their number.
     pub fn internal_force(&mut self, x_end: &[[f64; 3]], du: &[f64], f: &mut [f64]) {
         assert!(du.len() >= 6 * x_end.len() && f.len() >= 6 * x_end.len(), "6 dofs per node");
-        let np = self.settings.rule.len();
-        for (e, conn) in self.conn.iter().enumerate() {
-            let nodes = conn.map(|n| n as usize);
-            let xe = nodes.map(|n| x_end[n]);
-            let xm = nodes.map(|n| std::array::from_fn(|k| x_end[n][k] - 0.5 * du[6 * n + k]));
-            let dv = nodes.map(|n| std::array::from_fn(|k| du[6 * n + k]));
-            let (s, a, q) = (e * np * N_STRESS, e * np, e * N_SHEAR);
-            let fe = element(
-                &self.material,
-                &self.settings,
-                Geometry { x_end: &xe, x_mid: &xm, du: &dv, h: self.thickness[e] },
-                Committed {
-                    stress: &self.committed.stress[s..s + np * N_STRESS],
-                    alpha: &self.committed.alpha[a..a + np],
-                    shear: &self.committed.shear[q..q + N_SHEAR],
-                },
-                Trial {
-                    stress: &mut self.trial.stress[s..s + np * N_STRESS],
-                    alpha: &mut self.trial.alpha[a..a + np],
-                    shear: &mut self.trial.shear[q..q + N_SHEAR],
-                },
-            );
-            for (i, &n) in nodes.iter().enumerate() {
-                for k in 0..6 {
-                    f[6 * n + k] += fe[i][k];
-                }
-            }
-        }
+        self.threaded_force(x_end, du, f);
     }
 }
 
-/// Gershgorin bound of the largest eigenvalue of `M^-1/2 K M^-1/2` of one element of
-/// thickness `h` in frame `f` (elastic moduli; `stable_dt`).
-fn max_frequency_squared(mat: &J2, set: &Blt3Settings, f: &Frame, h: f64) -> f64 {
-    let el = mat.elastic;
-    let r = rows(f);
-    let c = el.tangent_plane_stress();
-    let kgh = SHEAR_FACTOR * el.shear_modulus() * h;
-    let mut k = [[0.0; N_DOF]; N_DOF];
-    let mut add = |a: &[f64; N_DOF], b: &[f64; N_DOF], d: f64| {
-        if d != 0.0 {
-            for (ki, ai) in k.iter_mut().zip(a) {
-                for (kij, bj) in ki.iter_mut().zip(b) {
-                    *kij += f.area * d * ai * bj;
-                }
-            }
-        }
+/// The characteristic length of a triangle, its smallest altitude `2A / max side`.
+fn altitude(x: &[[f64; 3]; 3]) -> f64 {
+    let d = |i: usize, j: usize| {
+        ((x[i][0] - x[j][0]).powi(2) + (x[i][1] - x[j][1]).powi(2) + (x[i][2] - x[j][2]).powi(2))
+            .sqrt()
     };
-    for (rows, scale) in [(&r.membrane, h), (&r.curvature, h * h * h / 12.0)] {
-        for i in 0..3 {
-            for j in 0..3 {
-                add(&rows[i], &rows[j], scale * c[i][j]);
-            }
-        }
-    }
-    add(&r.shear[0], &r.shear[0], kgh);
-    add(&r.shear[1], &r.shear[1], kgh);
-    add(&r.shear[2], &r.shear[2], kgh * r.linear_shear_factor);
-    let m = el.rho * h * f.area / 3.0;
-    let i = set.rotary.of_node(m, h, f.area);
-    let mass = |d: usize| if d % 6 < 3 { m } else { i };
-    (0..N_DOF)
-        .map(|a| (0..N_DOF).map(|b| k[a][b].abs() / (mass(a) * mass(b)).sqrt()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
-
-/// One element's step geometry.
-struct Geometry<'a> {
-    x_end: &'a [[f64; 3]; 3],
-    x_mid: &'a [[f64; 3]; 3],
-    du: &'a [[f64; 6]; 3],
-    h: f64,
-}
-
-/// One element's committed state.
-struct Committed<'a> {
-    stress: &'a [f64],
-    alpha: &'a [f64],
-    shear: &'a [f64],
-}
-
-/// One element's trial state.
-struct Trial<'a> {
-    stress: &'a mut [f64],
-    alpha: &'a mut [f64],
-    shear: &'a mut [f64],
-}
-
-/// Local dofs of the increment in frame `f`; rotation increments as the mid-step spin of
-/// their Cayley transform, scaled by `2 tan(|Δθ|/2)/|Δθ|` (`bt4` takes its series
-/// `1 + |Δθ|²/12`): a rigid rotation's chord `Δu = (R - I) X` is exactly that spin applied to
-/// the mid geometry `(R + I) X / 2`, so translations and rotations agree and any rigid
-/// increment below a half turn is strain free.
-fn local_increment(f: &Frame, du: &[[f64; 6]; 3]) -> [f64; N_DOF] {
-    let mut d = [0.0; N_DOF];
-    for i in 0..3 {
-        let u = [du[i][0], du[i][1], du[i][2]];
-        let th = [du[i][3], du[i][4], du[i][5]];
-        let t2 = dot(th, th);
-        let t = t2.sqrt();
-        let cay = if t > 1e-3 { 2.0 * (0.5 * t).tan() / t } else { 1.0 + t2 / 12.0 };
-        for a in 0..3 {
-            d[6 * i + a] = dot(f.e[a], u);
-            d[6 * i + 3 + a] = dot(f.e[a], th) * cay;
-        }
-    }
-    d
-}
-
-/// One element: strain increments at the mid geometry, stress update at every thickness
-/// point, resultants, nodal forces and moments `A Bᵀ (N, M, Q)` in the end geometry (global).
-fn element(mat: &J2, set: &Blt3Settings, g: Geometry, old: Committed, new: Trial) -> [[f64; 6]; 3] {
-    let h = g.h;
-    let fm = frame(g.x_mid);
-    let rm = rows(&fm);
-    let d = local_increment(&fm, g.du);
-    let em = rm.membrane.map(|r| apply(&r, &d));
-    let kap = rm.curvature.map(|r| apply(&r, &d));
-    let gam = rm.shear.map(|r| apply(&r, &d));
-
-    // --- Membrane and bending through the thickness.
-    let el = mat.elastic;
-    let c = el.tangent_plane_stress();
-    let (mut n, mut m) = ([0.0; 3], [0.0; 3]);
-    for (p, (&zeta, &w)) in set.rule.points.iter().zip(&set.rule.weights).enumerate() {
-        let z = 0.5 * h * zeta;
-        let de = [em[0] + z * kap[0], em[1] + z * kap[1], em[2] + z * kap[2]];
-        let s = p * N_STRESS;
-        let trial = [
-            old.stress[s] + c[0][0] * de[0] + c[0][1] * de[1],
-            old.stress[s + 1] + c[1][0] * de[0] + c[1][1] * de[1],
-            old.stress[s + 2] + c[2][2] * de[2],
-        ];
-        let r = mat.return_plane_stress(trial, old.alpha[p], set.newton, 0.0);
-        new.stress[s..s + N_STRESS].copy_from_slice(&r.sigma);
-        new.alpha[p] = r.alpha;
-        let wn = 0.5 * h * w;
-        for k in 0..3 {
-            n[k] += wn * r.sigma[k];
-            m[k] += wn * z * r.sigma[k];
-        }
-    }
-    // --- Elastic transverse shear: Q = κ G h γ at the centroid, κ G h m c for the linear part.
-    let kgh = SHEAR_FACTOR * el.shear_modulus() * h;
-    let ks = [kgh, kgh, kgh * rm.linear_shear_factor];
-    for k in 0..N_SHEAR {
-        new.shear[k] = old.shear[k] + ks[k] * gam[k];
-    }
-
-    // --- Forces in the end frame.
-    let fe = frame(g.x_end);
-    let re = rows(&fe);
-    let mut fl = [0.0; N_DOF];
-    for (rows, s) in [(&re.membrane, n), (&re.curvature, m)] {
-        for (row, sk) in rows.iter().zip(s) {
-            for (o, b) in fl.iter_mut().zip(row) {
-                *o += fe.area * b * sk;
-            }
-        }
-    }
-    for (row, &q) in re.shear.iter().zip(new.shear.iter()) {
-        for (o, b) in fl.iter_mut().zip(row) {
-            *o += fe.area * b * q;
-        }
-    }
-    // --- Back to the global frame.
-    let mut out = [[0.0; 6]; 3];
-    for i in 0..3 {
-        for k in 0..3 {
-            out[i][k] = (0..3).map(|a| fe.e[a][k] * fl[6 * i + a]).sum();
-            out[i][3 + k] = (0..3).map(|a| fe.e[a][k] * fl[6 * i + 3 + a]).sum();
-        }
-    }
-    out
+    2.0 * frame(x).area / d(0, 1).max(d(1, 2)).max(d(2, 0))
 }

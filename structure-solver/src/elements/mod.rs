@@ -1,8 +1,9 @@
 //! Finite elements (DESIGN §6): one corotated frame shared by the shells and beams
 //! (`corotation`), the local small-strain elements it carries (`mitc4`, `dkt`, `beam`; J2
 //! shells integrated through the thickness in `layered`), the total-Lagrangian tetrahedron
-//! `tet4`, the explicit one-point shells `bt4` (quadrilateral) and `blt3` (triangle), and the element container the assembly loops
-//! over.
+//! `tet4`, the explicit one-point shells `bt4` (quadrilateral) and `blt3` (triangle) with
+//! the node phase of their threaded loops (`incidence`), and the element container the
+//! assembly loops over.
 
 pub mod beam;
 pub mod blt3;
@@ -10,6 +11,7 @@ pub mod bt4;
 pub mod corotation;
 pub mod dkt;
 pub mod element;
+mod incidence;
 pub mod layered;
 pub mod mitc4;
 pub mod rotation;

@@ -6,7 +6,8 @@
 //! time column holds the load factor), fields to `structure.xdmf`, the final cell fields to
 //! `structure_cells.csv`.
 //!
-//! Every structure is one `assembly::FeModel`; BT4 shells are its explicit-only part. Central
+//! Every structure is one `assembly::FeModel`; BT4 and BLT3 shells are its explicit-only part
+//! (`bt4` parts: BT4 on quadrilaterals, BLT3 on triangles). Central
 //! differences scale the shells' rotary inertia (`RotaryInertia::Scaled`), implicit and static
 //! runs keep the physical one. What happens before the first step is [`crate::prepare`]'s,
 //! shared with `check`.

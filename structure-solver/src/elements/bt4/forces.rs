@@ -5,7 +5,7 @@
 //!    nodes, run the kernel, write the trial state and the element forces (24 per element) to
 //!    a work array, so no two tasks write the same memory;
 //! 2. nodes, a node's force summing its elements' contributions in ascending element order
-//!    (a node-to-element incidence table built once), exactly the order of a serial scatter.
+//!    (`elements::incidence`), exactly the order of a serial scatter.
 //!
 //! So the forces are bitwise independent of the thread count and of rayon's splitting.
 //!
@@ -18,12 +18,11 @@ use rayon::prelude::*;
 
 use super::kernel::{element_block, BlockState, Constants, V};
 use super::{LANES, N_HOURGLASS, N_STRESS};
+use crate::elements::incidence::Incidence;
 use crate::material::lanes::{Lanes, Real};
 
 /// Blocks of elements per task of the first phase.
 pub const BLOCKS_PER_TASK: usize = 16;
-/// Nodes per task of the second phase.
-const NODES_PER_TASK: usize = 2048;
 /// Element forces per element in the work array: 6 per node, `[node][dof]`.
 const F_PER_ELEMENT: usize = 24;
 
@@ -79,46 +78,6 @@ impl SimdPath {
             #[allow(unreachable_patterns)]
             _ => None,
         }
-    }
-}
-
-/// Node-to-element incidence: the contributions `(element * 4 + local node)` of node `n` are
-/// `entries[start[n]..start[n + 1]]`, ascending.
-#[derive(Debug, Clone, Default)]
-pub(super) struct Incidence {
-    start: Vec<u32>,
-    entries: Vec<u32>,
-}
-
-impl Incidence {
-    pub fn new(conn: &[[u32; 4]], n_nodes: usize) -> Self {
-        let mut start = vec![0u32; n_nodes + 1];
-        for c in conn {
-            for &n in c {
-                start[n as usize + 1] += 1;
-            }
-        }
-        for i in 0..n_nodes {
-            start[i + 1] += start[i];
-        }
-        let mut next = start.clone();
-        let mut entries = vec![0u32; 4 * conn.len()];
-        for (e, c) in conn.iter().enumerate() {
-            for (i, &n) in c.iter().enumerate() {
-                entries[next[n as usize] as usize] = (4 * e + i) as u32;
-                next[n as usize] += 1;
-            }
-        }
-        Incidence { start, entries }
-    }
-
-    pub fn n_nodes(&self) -> usize {
-        self.start.len().saturating_sub(1)
-    }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        4 * (self.start.len() + self.entries.len())
     }
 }
 
@@ -286,18 +245,6 @@ pub(super) fn internal_force(
             };
             path.run(op).expect("a supported path");
         });
-    let (inc, forces) = (&work.incidence, &work.forces);
-    f[..6 * nn].par_chunks_mut(6 * NODES_PER_TASK).enumerate().for_each(|(task, fc)| {
-        let n0 = task * NODES_PER_TASK;
-        for (j, fnode) in fc.chunks_exact_mut(6).enumerate() {
-            let n = n0 + j;
-            for &c in &inc.entries[inc.start[n] as usize..inc.start[n + 1] as usize] {
-                let src = &forces[6 * c as usize..6 * c as usize + 6];
-                for d in 0..6 {
-                    fnode[d] += src[d];
-                }
-            }
-        }
-    });
+    work.incidence.add_rows(&work.forces, f);
     Some(())
 }
