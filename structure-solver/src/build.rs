@@ -251,8 +251,11 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                     return Err(field_error(
                         case,
                         &f("element"),
-                        format!("{e:?} needs {needs}; cell {c} of set \"{set}\" is a {kind:?}")
-                            .to_lowercase(),
+                        format!(
+                            "{e:?} needs {needs}; cell {} of set \"{set}\" is a {kind:?}",
+                            mesh.cell_user(c)
+                        )
+                        .to_lowercase(),
                     ));
                 }
             };
@@ -260,19 +263,29 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                 return Err(field_error(
                     case,
                     &f("set"),
-                    format!("cell {c} already belongs to structure.parts[{other}]"),
+                    format!(
+                        "cell {} already belongs to structure.parts[{other}]",
+                        mesh.cell_user(c)
+                    ),
                 ));
             }
             out[c] = Some((k, part));
         }
     }
-    if let Some(c) =
-        (0..out.len()).find(|&c| out[c].is_none() && dimension(mesh.cells[c].kind) == top_dim)
+    // the first in the user's numbering
+    if let Some(c) = mesh
+        .cells_in_user_order()
+        .into_iter()
+        .find(|&c| out[c].is_none() && dimension(mesh.cells[c].kind) == top_dim)
     {
         return Err(field_error(
             case,
             "structure.parts",
-            format!("cell {c} (a {:?}) belongs to no part; add a part over it", mesh.cells[c].kind),
+            format!(
+                "cell {} (a {:?}) belongs to no part; add a part over it",
+                mesh.cell_user(c),
+                mesh.cells[c].kind
+            ),
         ));
     }
     Ok(out.into_iter().map(|p| p.map(|(_, part)| part)).collect())
@@ -367,8 +380,9 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
                 case,
                 &format!("{f}.set"),
                 format!(
-                    "node {n} moves with structure.rigid_bodies[{b}]; constrain its reference \
+                    "node {} moves with structure.rigid_bodies[{b}]; constrain its reference \
                      node, set \"{}_reference\"",
+                    mesh.node_id(n),
                     s.rigid_bodies[b].set
                 ),
             ));
@@ -435,7 +449,8 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
                         case,
                         &format!("{f}.set"),
                         format!(
-                            "a pressure acts on the shells of a part; cell {bad} is a {:?}{}",
+                            "a pressure acts on the shells of a part; cell {} is a {:?}{}",
+                            mesh.cell_user(*bad),
                             mesh.cells[*bad].kind,
                             if model_cell[*bad].is_none() { " of no part" } else { "" }
                         ),
