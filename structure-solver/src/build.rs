@@ -191,12 +191,14 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                 field_error(case, "structure.material", "is required to run structure-solver")
             })?,
         };
-        let cells = match &p.set {
+        let mut cells = match &p.set {
             Some(name) => cell_set(mesh, name, &f("set"), case)?,
             None => (0..mesh.cells.len())
                 .filter(|&c| dimension(mesh.cells[c].kind) == top_dim)
                 .collect(),
         };
+        // in the user's order, so an error names the user's first offending cell
+        cells.sort_by_key(|&c| mesh.cell_user(c));
         let h = p.thickness.unwrap_or_default();
         let (section, yield_) = shell(m, h, p.points);
         for c in cells {

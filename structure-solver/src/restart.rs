@@ -6,7 +6,9 @@
 //! spins `spins` (BT4 shells read their increments from them), the J2 state of every element
 //! `material`, and for BT4 shells per point the stresses, equivalent plastic strain and
 //! hourglass stresses (`bt4.*`). A restart restores all of it, so it reproduces the run
-//! bitwise.
+//! bitwise. Arrays are in the model's storage order (the slots of the renumbered mesh,
+//! [`crate::mesh::renumber`]), which the same case always rebuilds: a checkpoint is a restart
+//! state, not an output in the user's numbering.
 
 use interface_protocol::io::checkpoint::Checkpoint;
 use nalgebra::{Matrix3, Vector3};
