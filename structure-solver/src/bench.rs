@@ -70,15 +70,23 @@ pub struct CReference {
 
 /// What the locality renumbering does to the bench plate: rates of the first thread count
 /// (natural over shuffled numbering, renumbered over as given), and the node-graph profile and
-/// mean node-slot spread of an element in each numbering.
+/// mean node-slot spread of an element in each numbering. Renumbered, the natural and the
+/// shuffled plate are stored alike, so their ratio shows the noise of the measurement.
 #[derive(Debug, Serialize)]
 pub struct LocalityBench {
     pub threads: usize,
-    pub natural_over_shuffled_as_given: f64,
-    pub natural_over_shuffled_renumbered: f64,
-    pub renumbered_over_as_given_natural: f64,
-    pub renumbered_over_as_given_shuffled: f64,
+    pub natural_over_shuffled_as_given: Ratio,
+    pub natural_over_shuffled_renumbered: Ratio,
+    pub renumbered_over_as_given_natural: Ratio,
+    pub renumbered_over_as_given_shuffled: Ratio,
     pub numberings: Vec<NumberingLocality>,
+}
+
+/// A ratio of rates per second of wall-clock time and per second of processor time.
+#[derive(Debug, Serialize)]
+pub struct Ratio {
+    pub wall: f64,
+    pub cpu: f64,
 }
 
 /// The node graph of one numbering of the bench plate.
@@ -396,16 +404,21 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
             position_difference: None,
         },
     };
+    let find = |order: &str, renumbered: bool, t: usize| {
+        runs.iter().find(|r| r.order == order && r.renumbered == renumbered && r.threads == t)
+    };
     let rate = |order: &str, renumbered: bool, t: usize| {
-        runs.iter()
-            .find(|r| r.order == order && r.renumbered == renumbered && r.threads == t)
-            .map(|r| r.element_updates_per_s)
+        find(order, renumbered, t).map(|r| r.element_updates_per_s)
     };
     let speedup =
         |order: &str| rate(order, false, 1).zip(rate(order, false, 2)).map(|(a, b)| b / a);
     let t0 = threads[0];
-    let ratio = |a: (&str, bool), b: (&str, bool)| {
-        rate(a.0, a.1, t0).zip(rate(b.0, b.1, t0)).map_or(f64::NAN, |(a, b)| a / b)
+    let ratio = |a: (&str, bool), b: (&str, bool)| match (find(a.0, a.1, t0), find(b.0, b.1, t0)) {
+        (Some(a), Some(b)) => Ratio {
+            wall: a.element_updates_per_s / b.element_updates_per_s,
+            cpu: a.element_updates_per_cpu_s / b.element_updates_per_cpu_s,
+        },
+        _ => Ratio { wall: f64::NAN, cpu: f64::NAN },
     };
     let locality = LocalityBench {
         threads: t0,
