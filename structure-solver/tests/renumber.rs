@@ -287,3 +287,22 @@ fn a_shuffled_gmsh_file_gives_the_outputs_of_the_natural_one_per_user_id() {
         assert_eq!(x_n[n], natural.nodes[n].to_vec(), "natural points in the user's order");
     }
 }
+
+#[test]
+fn the_wet_surface_keeps_the_users_order_when_renumbered() {
+    use structure_solver::couple::wet_surface;
+    let mut plate = rectangle(1.0, 0.5, 6, 4);
+    let strip = plate.nodes_where(|p| p[0] < 0.4);
+    plate.node_sets.insert("strip".into(), strip);
+    let tets = block([1.0, 1.0, 1.0], [2, 2, 2]);
+    for (mesh, set) in [(&plate, "all"), (&plate, "strip"), (&tets, "all")] {
+        let m = shuffle_numbering(mesh, 11);
+        let r = renumber(m.clone());
+        let (given, renumbered) = (wet_surface(&m, set).unwrap(), wet_surface(&r, set).unwrap());
+        // the same wet nodes (by user number) in the same order, the same faces
+        let users: Vec<usize> = renumbered.nodes.iter().map(|&s| r.node_user(s)).collect();
+        assert_eq!(users, given.nodes, "wet set {set}");
+        assert_eq!(renumbered.elements, given.elements, "wet set {set}");
+        assert!(!given.elements.is_empty());
+    }
+}
