@@ -1,6 +1,7 @@
 //! `structure-solver bench`: the speed of whole explicit BT4 steps (element updates per second
 //! per core, J2 with the plane-stress return at 5 thickness points; natural and shuffled
-//! element order, 1 and 2 threads) and of an implicit
+//! input numbering, each as given and renumbered for locality as the model build does
+//! ([`crate::mesh::renumber`]), 1 and 2 threads) and of an implicit
 //! Newmark step of a 10k-node MITC4 shell with the time of each piece of a Newton iteration
 //! (internal force, tangent, factorisation, solve), printed as JSON (DESIGN §6, §7).
 
@@ -13,6 +14,8 @@ use crate::elements::bt4::{Bt4, Bt4Settings, SimdPath, LANES};
 use crate::elements::ShellSection;
 use crate::material::{Elastic, J2};
 use crate::mesh::generate::rectangle;
+use crate::mesh::renumber::{bandwidth_profile, mean_cell_spread, renumber, shuffle_numbering};
+use crate::mesh::Mesh;
 use crate::time::{Implicit, ImplicitScheme};
 
 /// Bench results.
@@ -43,6 +46,8 @@ pub struct ExplicitBench {
     /// Element updates per second on 2 threads over 1 thread, natural order.
     pub speedup_2_threads_natural: Option<f64>,
     pub speedup_2_threads_shuffled: Option<f64>,
+    /// Natural against shuffled numbering, as given and renumbered.
+    pub locality: LocalityBench,
     /// The C reference of the same step (natural order, one thread), measured in this run.
     pub c_reference: CReference,
 }
@@ -63,11 +68,45 @@ pub struct CReference {
     pub position_difference: Option<f64>,
 }
 
+/// What the locality renumbering does to the bench plate: rates of the first thread count
+/// (natural over shuffled numbering, renumbered over as given), and the node-graph profile and
+/// mean node-slot spread of an element in each numbering. Renumbered, the natural and the
+/// shuffled plate are stored alike, so their ratio shows the noise of the measurement.
+#[derive(Debug, Serialize)]
+pub struct LocalityBench {
+    pub threads: usize,
+    pub natural_over_shuffled_as_given: Ratio,
+    pub natural_over_shuffled_renumbered: Ratio,
+    pub renumbered_over_as_given_natural: Ratio,
+    pub renumbered_over_as_given_shuffled: Ratio,
+    pub numberings: Vec<NumberingLocality>,
+}
+
+/// A ratio of rates per second of wall-clock time and per second of processor time.
+#[derive(Debug, Serialize)]
+pub struct Ratio {
+    pub wall: f64,
+    pub cpu: f64,
+}
+
+/// The node graph of one numbering of the bench plate.
+#[derive(Debug, Serialize)]
+pub struct NumberingLocality {
+    pub order: &'static str,
+    pub renumbered: bool,
+    pub bandwidth: usize,
+    pub profile: usize,
+    pub mean_element_spread: f64,
+}
+
 /// One whole explicit step (forces, velocity and position update, stable step), timed.
 #[derive(Debug, Serialize)]
 pub struct ExplicitRun {
-    /// `natural` (row by row) or `shuffled` element order.
+    /// `natural` (row by row) or `shuffled` (a fixed-seed permutation of the node and element
+    /// numbering) input.
     pub order: &'static str,
+    /// Whether the input was renumbered for locality, as the model build does.
+    pub renumbered: bool,
     pub threads: usize,
     /// Share of thickness points yielding in the timed steps.
     pub plastic_fraction: f64,
@@ -160,33 +199,40 @@ fn steel() -> J2 {
     J2 { elastic: Elastic { e: 200e9, nu: 0.3, rho: 7800.0 }, sigma_y: 250e6, h: 1e9 }
 }
 
-/// The bench plate: `n x n` quads on the unit square, its connectivity in natural or
-/// shuffled order.
+/// The seed of the bench's shuffled numbering.
+const SHUFFLE_SEED: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// The bench plate: `n x n` quads on the unit square, numbered row by row (natural) or at
+/// random (shuffled), as given or renumbered for locality.
 pub struct Bt4Plate {
+    pub mesh: Mesh,
     pub x0: Vec<[f64; 3]>,
     pub conn: Vec<[u32; 4]>,
 }
 
 impl Bt4Plate {
-    pub fn new(elements: usize, shuffled: bool) -> Bt4Plate {
+    pub fn new(elements: usize, shuffled: bool, renumbered: bool) -> Bt4Plate {
         let n = (elements as f64).sqrt().ceil().max(1.0) as usize;
-        let mesh = rectangle(1.0, 1.0, n, n);
-        let mut conn: Vec<[u32; 4]> = mesh
+        let mut mesh = rectangle(1.0, 1.0, n, n);
+        if shuffled {
+            mesh = shuffle_numbering(&mesh, SHUFFLE_SEED);
+        }
+        if renumbered {
+            mesh = renumber(mesh);
+        }
+        let conn: Vec<[u32; 4]> = mesh
             .cells
             .iter()
             .map(|c| [c.nodes[0], c.nodes[1], c.nodes[2], c.nodes[3]].map(|v| v as u32))
             .collect();
-        if shuffled {
-            // Fisher-Yates with a fixed xorshift sequence.
-            let mut r = 0x9e37_79b9_7f4a_7c15u64;
-            for i in (1..conn.len()).rev() {
-                r ^= r << 13;
-                r ^= r >> 7;
-                r ^= r << 17;
-                conn.swap(i, (r % (i as u64 + 1)) as usize);
-            }
-        }
-        Bt4Plate { x0: mesh.nodes, conn }
+        Bt4Plate { x0: mesh.nodes.clone(), conn, mesh }
+    }
+
+    /// The node graph's locality in this numbering.
+    fn locality(&self, order: &'static str, renumbered: bool) -> NumberingLocality {
+        let (bandwidth, profile) = bandwidth_profile(&self.mesh);
+        let mean_element_spread = mean_cell_spread(&self.mesh);
+        NumberingLocality { order, renumbered, bandwidth, profile, mean_element_spread }
     }
 
     /// Initial velocity (6 per node): a biaxial stretch at 160/s and a transverse sine at
@@ -277,11 +323,15 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
         "--threads must list thread counts of at least 1, e.g. 1,2"
     );
     let mut runs = Vec::new();
+    let mut numberings = Vec::new();
     let mut info = None;
     let mut rust_end: Option<Vec<[f64; 3]>> = None;
     const WARMUP: usize = 20;
-    for (order, shuffled) in [("natural", false), ("shuffled", true)] {
-        let plate = Bt4Plate::new(elements, shuffled);
+    let inputs = [("natural", false), ("shuffled", true)];
+    for ((order, shuffled), renumbered) in inputs.into_iter().flat_map(|o| [(o, false), (o, true)])
+    {
+        let plate = Bt4Plate::new(elements, shuffled, renumbered);
+        numberings.push(plate.locality(order, renumbered));
         for &t in threads {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(t).build()?;
             let mut sim = Bt4Explicit::new(&plate);
@@ -301,7 +351,7 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
                 let updates = (sim.bt4.n_elements() * steps) as f64;
                 (updates / secs, updates / cpu, yielding as f64 / alpha.len() as f64)
             });
-            if !shuffled && rust_end.is_none() {
+            if !shuffled && !renumbered && rust_end.is_none() {
                 rust_end = Some(sim.x.clone());
             }
             let s = &sim.bt4.settings;
@@ -313,6 +363,7 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
             ));
             runs.push(ExplicitRun {
                 order,
+                renumbered,
                 threads: t,
                 plastic_fraction: plastic,
                 element_updates_per_s: rate,
@@ -323,7 +374,7 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
         }
     }
     let (ne, np, newton, bytes) = info.expect("one run at least");
-    let natural = Bt4Plate::new(elements, false);
+    let natural = Bt4Plate::new(elements, false, false);
     let c_reference = match c_reference(&natural, WARMUP, steps) {
         Ok((secs, cpu, x_c)) => {
             let rate = (ne * steps) as f64 / secs;
@@ -353,13 +404,29 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
             position_difference: None,
         },
     };
-    let speedup = |order: &str| {
-        let r = |t: usize| {
-            runs.iter()
-                .find(|r| r.order == order && r.threads == t)
-                .map(|r| r.element_updates_per_s)
-        };
-        r(1).zip(r(2)).map(|(one, two)| two / one)
+    let find = |order: &str, renumbered: bool, t: usize| {
+        runs.iter().find(|r| r.order == order && r.renumbered == renumbered && r.threads == t)
+    };
+    let rate = |order: &str, renumbered: bool, t: usize| {
+        find(order, renumbered, t).map(|r| r.element_updates_per_s)
+    };
+    let speedup =
+        |order: &str| rate(order, false, 1).zip(rate(order, false, 2)).map(|(a, b)| b / a);
+    let t0 = threads[0];
+    let ratio = |a: (&str, bool), b: (&str, bool)| match (find(a.0, a.1, t0), find(b.0, b.1, t0)) {
+        (Some(a), Some(b)) => Ratio {
+            wall: a.element_updates_per_s / b.element_updates_per_s,
+            cpu: a.element_updates_per_cpu_s / b.element_updates_per_cpu_s,
+        },
+        _ => Ratio { wall: f64::NAN, cpu: f64::NAN },
+    };
+    let locality = LocalityBench {
+        threads: t0,
+        natural_over_shuffled_as_given: ratio(("natural", false), ("shuffled", false)),
+        natural_over_shuffled_renumbered: ratio(("natural", true), ("shuffled", true)),
+        renumbered_over_as_given_natural: ratio(("natural", true), ("natural", false)),
+        renumbered_over_as_given_shuffled: ratio(("shuffled", true), ("shuffled", false)),
+        numberings,
     };
     Ok(ExplicitBench {
         elements: ne,
@@ -373,6 +440,7 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
         plastic_fraction: runs[0].plastic_fraction,
         speedup_2_threads_natural: speedup("natural"),
         speedup_2_threads_shuffled: speedup("shuffled"),
+        locality,
         runs,
         c_reference,
     })

@@ -193,12 +193,14 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                 field_error(case, "structure.material", "is required to run structure-solver")
             })?,
         };
-        let cells = match &p.set {
+        let mut cells = match &p.set {
             Some(name) => cell_set(mesh, name, &f("set"), case)?,
             None => (0..mesh.cells.len())
                 .filter(|&c| dimension(mesh.cells[c].kind) == top_dim)
                 .collect(),
         };
+        // in the user's order, so an error names the user's first offending cell
+        cells.sort_by_key(|&c| mesh.cell_user(c));
         let h = p.thickness.unwrap_or_default();
         let (section, yield_) = shell(m, h, p.points);
         if let (ElementType::Bt4, Some(y)) = (p.element, yield_) {
@@ -268,8 +270,11 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                     return Err(field_error(
                         case,
                         &f("element"),
-                        format!("{e:?} needs {needs}; cell {c} of set \"{set}\" is a {kind:?}")
-                            .to_lowercase(),
+                        format!(
+                            "{e:?} needs {needs}; cell {} of set \"{set}\" is a {kind:?}",
+                            mesh.cell_user(c)
+                        )
+                        .to_lowercase(),
                     ));
                 }
             };
@@ -277,19 +282,29 @@ fn cell_parts(s: &StructureSection, mesh: &Mesh, case: &Case) -> anyhow::Result<
                 return Err(field_error(
                     case,
                     &f("set"),
-                    format!("cell {c} already belongs to structure.parts[{other}]"),
+                    format!(
+                        "cell {} already belongs to structure.parts[{other}]",
+                        mesh.cell_user(c)
+                    ),
                 ));
             }
             out[c] = Some((k, part));
         }
     }
-    if let Some(c) =
-        (0..out.len()).find(|&c| out[c].is_none() && dimension(mesh.cells[c].kind) == top_dim)
+    // the first in the user's numbering
+    if let Some(c) = mesh
+        .cells_in_user_order()
+        .into_iter()
+        .find(|&c| out[c].is_none() && dimension(mesh.cells[c].kind) == top_dim)
     {
         return Err(field_error(
             case,
             "structure.parts",
-            format!("cell {c} (a {:?}) belongs to no part; add a part over it", mesh.cells[c].kind),
+            format!(
+                "cell {} (a {:?}) belongs to no part; add a part over it",
+                mesh.cell_user(c),
+                mesh.cells[c].kind
+            ),
         ));
     }
     Ok(out.into_iter().map(|p| p.map(|(_, part)| part)).collect())
@@ -378,8 +393,9 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
                 case,
                 &format!("{f}.set"),
                 format!(
-                    "node {n} moves with structure.rigid_bodies[{b}]; constrain its reference \
+                    "node {} moves with structure.rigid_bodies[{b}]; constrain its reference \
                      node, set \"{}_reference\"",
+                    mesh.node_id(n),
                     s.rigid_bodies[b].set
                 ),
             ));
@@ -446,7 +462,8 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
                         case,
                         &format!("{f}.set"),
                         format!(
-                            "a pressure acts on the shells of a part; cell {bad} is a {:?}{}",
+                            "a pressure acts on the shells of a part; cell {} is a {:?}{}",
+                            mesh.cell_user(*bad),
                             mesh.cells[*bad].kind,
                             if model_cell[*bad].is_none() { " of no part" } else { "" }
                         ),

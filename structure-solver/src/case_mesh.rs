@@ -1,6 +1,7 @@
 //! The mesh of a case's `[structure]`: a generator (its size checked against the machine's
 //! memory before anything is allocated, coincident seam nodes merged) or a gmsh file, through
-//! the one validity pass of [`crate::mesh::validate`]; then the box sets and the sets `all`.
+//! the one validity pass of [`crate::mesh::validate`]; then the box sets and the sets `all`,
+//! and the locality renumbering of [`crate::mesh::renumber`] (the user's numbers kept apart).
 //! Nodes at one position that no element shares draw a warning on stderr unless the mesh
 //! declares them intended (`coincident_nodes = "allow"`).
 
@@ -11,6 +12,7 @@ use interface_protocol::resources::{bytes_for, ensure_memory, ResourceError};
 
 use crate::build::{field_error, need};
 use crate::mesh::merge::{merge_coincident, Collapsed};
+use crate::mesh::renumber::renumber;
 use crate::mesh::validate::{self, coincident_nodes, coincident_warning, Invalid};
 use crate::mesh::{generate, gmsh, CellKind, Mesh};
 
@@ -73,7 +75,8 @@ fn grid_of(m: &StructureMesh) -> Option<(&'static str, usize, usize, bool)> {
     })
 }
 
-/// The generated or read mesh, with the box sets, the node set `all` and the cell set `all`.
+/// The generated or read mesh, with the box sets, the node set `all` and the cell set `all`,
+/// stored in locality order ([`renumber`]); its numberings give the user's numbers.
 pub fn build_mesh(s: &StructureSection, case: &Case) -> anyhow::Result<Mesh> {
     let spec = need(&s.mesh, "mesh", case)?;
     let mut mesh = match spec {
@@ -125,7 +128,7 @@ pub fn build_mesh(s: &StructureSection, case: &Case) -> anyhow::Result<Mesh> {
     }
     mesh.node_sets.insert("all".into(), (0..mesh.nodes.len()).collect());
     mesh.cell_sets.insert("all".into(), (0..mesh.cells.len()).collect());
-    Ok(mesh)
+    Ok(renumber(mesh))
 }
 
 /// The mesh of a generator, refused before allocating when the machine cannot hold its model,

@@ -8,11 +8,15 @@
 //! largest equivalent plastic strain through the thickness of J2 shells and explicit shells
 //! (tets: at their point) when the model has plastic states. `structure_cells.csv` holds the
 //! final cell fields with the cell centroids.
+//!
+//! Both speak the user's numbering, not the storage order of the renumbered mesh
+//! ([`crate::mesh::renumber`]): nodes and cells are written in the user's order (cells grouped
+//! by kind, in the user's order within a kind), and the table's `cell` is the user's number.
 
 use std::io::Write;
 use std::path::Path;
 
-use interface_protocol::io::finite::{check_finite, Entity};
+use interface_protocol::io::finite::{check_finite, Entity, NonFiniteError};
 use interface_protocol::io::xdmf::{
     CellBlock, CellKind as XdmfKind, Connectivity, Field, Location, Mesh as XdmfMesh,
     TimeSeriesWriter, Values,
@@ -99,7 +103,8 @@ pub fn cell_fields(model: &FeModel, map: &CellMap) -> Vec<(&'static str, Vec<f64
     out
 }
 
-/// Writes `cell,x,y,z,<fields>`: the final cell fields at the cell centroids.
+/// Writes `cell,x,y,z,<fields>`: the final cell fields at the cell centroids, a row per cell in
+/// the user's order, `cell` its user number.
 pub fn write_cell_table(
     path: &Path,
     mesh: &Mesh,
@@ -113,11 +118,12 @@ pub fn write_cell_table(
         write!(w, ",{name}")?;
     }
     writeln!(w)?;
-    for (c, cell) in mesh.cells.iter().enumerate() {
+    for c in mesh.cells_in_user_order() {
+        let cell = &mesh.cells[c];
         let k = cell.nodes.len() as f64;
         let x: [f64; 3] =
             std::array::from_fn(|i| cell.nodes.iter().map(|&n| mesh.nodes[n][i]).sum::<f64>() / k);
-        write!(w, "{c},{:e},{:e},{:e}", x[0], x[1], x[2])?;
+        write!(w, "{},{:e},{:e},{:e}", mesh.cell_user(c), x[0], x[1], x[2])?;
         for (_, v) in &fields {
             write!(w, ",{:e}", v[c])?;
         }
@@ -140,8 +146,16 @@ fn xdmf_kind(k: CellKind) -> XdmfKind {
 /// The `structure.xdmf` series with its per-node work arrays.
 pub struct FieldOutput {
     writer: TimeSeriesWriter,
-    /// Mesh cell of each output cell (cells are written grouped by kind).
+    /// Mesh cell of each output cell (cells are written grouped by kind, in the user's order).
     cell_order: Vec<usize>,
+    /// Node slot of each output node (the user's order) and the user's number of each slot;
+    /// both empty when the user's order is the storage order.
+    node_order: Vec<usize>,
+    node_user: Vec<usize>,
+    /// The user's number of each cell slot, naming a cell in a stop.
+    cell_user: Vec<usize>,
+    /// Scratch of one nodal field in the user's order.
+    reordered: Vec<[f64; 3]>,
     /// The cells of the model's elements, when the series carries cell fields.
     cells: Option<CellMap>,
     cell_fields: Vec<(&'static str, Vec<f64>)>,
@@ -150,15 +164,19 @@ pub struct FieldOutput {
 }
 
 impl FieldOutput {
-    /// Starts `structure.h5` + `structure.xdmf` in `dir` with the mesh's nodes and cells; with
-    /// `cells`, each step also carries the cell fields of the model.
+    /// Starts `structure.h5` + `structure.xdmf` in `dir` with the mesh's nodes and cells in the
+    /// user's order; with `cells`, each step also carries the cell fields of the model.
     pub fn create(dir: &Path, mesh: &Mesh, cells: Option<CellMap>) -> anyhow::Result<FieldOutput> {
         let kinds = [CellKind::Line2, CellKind::Tri3, CellKind::Quad4, CellKind::Tet4];
+        let user_cells = mesh.cells_in_user_order();
+        let node_order = mesh.nodes_in_user_order();
+        let identity = node_order.iter().enumerate().all(|(u, &s)| u == s);
         let conn: Vec<(CellKind, Vec<u32>)> = kinds
             .iter()
             .map(|&k| {
-                let c = mesh.cells.iter().filter(|c| c.kind == k);
-                (k, c.flat_map(|c| c.nodes.iter().map(|&n| n as u32)).collect::<Vec<u32>>())
+                let c = user_cells.iter().map(|&c| &mesh.cells[c]).filter(|c| c.kind == k);
+                let user = |n: usize| mesh.node_user(n) as u32;
+                (k, c.flat_map(|c| c.nodes.iter().map(|&n| user(n))).collect::<Vec<u32>>())
             })
             .filter(|(_, c)| !c.is_empty())
             .collect();
@@ -166,19 +184,28 @@ impl FieldOutput {
             .iter()
             .map(|(k, c)| CellBlock { kind: xdmf_kind(*k), connectivity: Connectivity::U32(c) })
             .collect();
+        let points: Vec<[f64; 3]> = node_order.iter().map(|&s| mesh.nodes[s]).collect();
         let writer = TimeSeriesWriter::create(
             dir,
             "structure",
-            &XdmfMesh { points: &mesh.nodes, blocks: &blocks },
+            &XdmfMesh { points: &points, blocks: &blocks },
         )?;
         let n = mesh.nodes.len();
         let cell_order = kinds
             .iter()
-            .flat_map(|&k| (0..mesh.cells.len()).filter(move |&c| mesh.cells[c].kind == k))
+            .flat_map(|&k| user_cells.iter().copied().filter(move |&c| mesh.cells[c].kind == k))
             .collect();
         Ok(FieldOutput {
             writer,
             cell_order,
+            node_order: if identity { Vec::new() } else { node_order },
+            node_user: if identity {
+                Vec::new()
+            } else {
+                (0..n).map(|s| mesh.node_user(s)).collect()
+            },
+            cell_user: (0..mesh.cells.len()).map(|c| mesh.cell_user(c)).collect(),
+            reordered: Vec::new(),
             cells,
             cell_fields: Vec::new(),
             displacement: vec![[0.0; 3]; n],
@@ -195,13 +222,22 @@ impl FieldOutput {
         fe: Option<&FeModel>,
         v: &[f64],
     ) -> anyhow::Result<()> {
-        gather_nodal(t, model, v, &mut self.displacement, &mut self.velocity)?;
+        let user = |s: usize| self.node_user.get(s).copied().unwrap_or(s);
+        gather_nodal(t, model, v, &mut self.displacement, &mut self.velocity, &user)?;
+        if !self.node_order.is_empty() {
+            for field in [&mut self.displacement, &mut self.velocity] {
+                self.reordered.clear();
+                self.reordered.extend(self.node_order.iter().map(|&s| field[s]));
+                std::mem::swap(field, &mut self.reordered);
+            }
+        }
         self.cell_fields = match (&self.cells, fe) {
             (Some(map), Some(fe)) => cell_fields(fe, map),
             _ => Vec::new(),
         };
         for (name, values) in &mut self.cell_fields {
-            check_finite(name, Entity::Element, t, &values[..])?;
+            check_finite(name, Entity::Element, t, &values[..])
+                .map_err(|e| NonFiniteError { index: self.cell_user[e.index], ..e })?;
             *values = self.cell_order.iter().map(|&c| values[c]).collect();
         }
         Ok(())
@@ -228,6 +264,11 @@ impl FieldOutput {
         Ok(())
     }
 
+    /// The user's number of node slot `s`.
+    pub fn node_user(&self, s: usize) -> usize {
+        self.node_user.get(s).copied().unwrap_or(s)
+    }
+
     /// Steps written so far.
     pub fn steps(&self) -> usize {
         self.writer.steps()
@@ -240,20 +281,23 @@ impl FieldOutput {
     }
 }
 
-/// Nodal displacement and translational velocity of the model at `t`, checked finite: the first
-/// non-finite value stops the run naming the field, node and time.
+/// Nodal displacement and translational velocity of the model at `t` (storage order), checked
+/// finite: the first non-finite value stops the run naming the field, the node by its user
+/// number `user(slot)`, and the time.
 pub fn gather_nodal(
     t: f64,
     model: &dyn Model,
     v: &[f64],
     displacement: &mut [[f64; 3]],
     velocity: &mut [[f64; 3]],
+    user: &dyn Fn(usize) -> usize,
 ) -> anyhow::Result<()> {
     model.displacement(displacement);
     for (i, o) in velocity.iter_mut().enumerate() {
         o.copy_from_slice(&v[6 * i..6 * i + 3]);
     }
-    check_finite("displacement", Entity::Node, t, displacement)?;
-    check_finite("velocity", Entity::Node, t, velocity)?;
+    let named = |e: NonFiniteError| NonFiniteError { index: user(e.index), ..e };
+    check_finite("displacement", Entity::Node, t, displacement).map_err(named)?;
+    check_finite("velocity", Entity::Node, t, velocity).map_err(named)?;
     Ok(())
 }

@@ -10,7 +10,10 @@
 //! (`topology.*`: version, node and element ids, reference positions, the user's fixed dofs,
 //! and the element list with the element each was copied from), so that a restart after a
 //! change at run time first rebuilds the changed model from the one its case builds. A
-//! restart restores all of it, so it reproduces the run bitwise.
+//! restart restores all of it, so it reproduces the run bitwise. Arrays are in the model's
+//! storage order (the slots of the renumbered mesh, [`crate::mesh::renumber`]), which the
+//! same case always rebuilds: a checkpoint is a restart state, not an output in the user's
+//! numbering.
 
 use interface_protocol::io::checkpoint::Checkpoint;
 use nalgebra::{Matrix3, Vector3};

@@ -1,7 +1,8 @@
 //! The wet surface a structure sends to the fluid: the set `structure.wet_set` of shell faces
 //! (a cell set of the mesh, or the shells whose nodes all lie in that node set), or the outward
 //! boundary triangles of a cell set of tets; its nodes are numbered in order of first
-//! appearance in those faces.
+//! appearance in those faces, taken in the user's cell order: the protocol's order is the
+//! user's, whatever the storage order of the renumbered mesh.
 
 use interface_protocol::messages::SurfaceElement;
 
@@ -21,7 +22,14 @@ pub struct WetSurface {
 /// to the node set of that name.
 pub fn wet_surface(mesh: &Mesh, name: &str) -> Result<WetSurface, String> {
     let is_face = |k: CellKind| matches!(k, CellKind::Tri3 | CellKind::Quad4);
+    let by_user = |cells: &[usize]| {
+        let mut v = cells.to_vec();
+        v.sort_by_key(|&c| mesh.cell_user(c));
+        v
+    };
     let faces: Vec<Vec<usize>> = if let Ok(cells) = mesh.cell_set(name) {
+        let owned = by_user(cells);
+        let cells = &owned[..];
         let solid = cells.first().is_some_and(|&c| mesh.cells[c].kind == CellKind::Tet4);
         let expected = |k: CellKind| if solid { k == CellKind::Tet4 } else { is_face(k) };
         if let Some(&c) = cells.iter().find(|&&c| !expected(mesh.cells[c].kind)) {
@@ -31,7 +39,8 @@ pub fn wet_surface(mesh: &Mesh, name: &str) -> Result<WetSurface, String> {
                 "shell faces (triangles or quadrilaterals) or tetrahedra"
             };
             return Err(format!(
-                "wet set \"{name}\": cell {c} is a {:?}, expected {what}",
+                "wet set \"{name}\": cell {} is a {:?}, expected {what}",
+                mesh.cell_user(c),
                 mesh.cells[c].kind
             ));
         }
@@ -44,8 +53,9 @@ pub fn wet_surface(mesh: &Mesh, name: &str) -> Result<WetSurface, String> {
         let nodes = mesh.node_set(name).map_err(|e| format!("wet set: {e}"))?;
         let mut inside = vec![false; mesh.nodes.len()];
         nodes.iter().for_each(|&n| inside[n] = true);
-        mesh.cells
-            .iter()
+        mesh.cells_in_user_order()
+            .into_iter()
+            .map(|c| &mesh.cells[c])
             .filter(|c| is_face(c.kind) && c.nodes.iter().all(|&n| inside[n]))
             .map(|c| c.nodes.clone())
             .collect()

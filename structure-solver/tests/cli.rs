@@ -101,6 +101,18 @@ fn bench_prints_json_with_both_measurements() {
     assert!(v["explicit_bt4"]["element_updates_per_s_per_core"].as_f64().unwrap() > 0.0);
     assert!(v["explicit_bt4"]["plastic_fraction"].as_f64().unwrap() > 0.5);
     assert!(v["implicit_newmark"]["seconds_per_step"].as_f64().unwrap() > 0.0);
+    // natural and shuffled numbering, as given and renumbered, on 1 and 2 threads
+    let runs = v["explicit_bt4"]["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 8);
+    let locality = &v["explicit_bt4"]["locality"];
+    let numberings = locality["numberings"].as_array().unwrap();
+    let profile = |order: &str, renumbered: bool| {
+        let n = numberings.iter().find(|n| n["order"] == order && n["renumbered"] == renumbered);
+        n.unwrap()["profile"].as_f64().unwrap()
+    };
+    assert!(profile("shuffled", true) < 0.5 * profile("shuffled", false));
+    assert_eq!(profile("shuffled", true), profile("natural", true));
+    assert!(locality["renumbered_over_as_given_shuffled"]["wall"].as_f64().unwrap() > 0.0);
 }
 
 /// Tip deflection of a cantilever under a tip load `α = P L²/EI` as fractions of `L`: vertical

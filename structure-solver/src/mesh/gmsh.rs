@@ -89,8 +89,8 @@ fn from_msh(msh: Msh) -> Result<Mesh, GmshError> {
         v.dedup();
     }
     let Msh { coords: nodes, node_tags: node_ids, .. } = &msh;
-    let mesh =
-        Mesh { nodes: nodes.clone(), cells, node_sets, cell_sets, node_ids: node_ids.clone() };
+    let (node_ids, nodes) = (node_ids.clone(), nodes.clone());
+    let mesh = Mesh { nodes, cells, node_sets, cell_sets, node_ids, ..Mesh::default() };
     match validate::check(&mesh) {
         Ok(()) => Ok(mesh),
         Err(e @ Invalid::Cell { cell, .. }) => {

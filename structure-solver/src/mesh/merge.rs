@@ -66,5 +66,5 @@ pub fn merge_coincident(mesh: Mesh) -> Result<Mesh, Collapsed> {
             (name, out)
         })
         .collect();
-    Ok(Mesh { nodes, cells, node_sets, cell_sets: mesh.cell_sets, node_ids })
+    Ok(Mesh { nodes, cells, node_sets, cell_sets: mesh.cell_sets, node_ids, ..Mesh::default() })
 }

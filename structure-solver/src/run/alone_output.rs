@@ -38,7 +38,8 @@ impl AloneOutput {
         if !(probe || field) {
             return Ok(());
         }
-        gather_nodal(t, model, v, &mut self.disp, &mut self.vel)?;
+        let user = |s: usize| self.fields.node_user(s);
+        gather_nodal(t, model, v, &mut self.disp, &mut self.vel, &user)?;
         if probe {
             let mut row = Vec::with_capacity(6 * self.probe_nodes.len());
             for &p in &self.probe_nodes {
