@@ -120,6 +120,7 @@ impl EmbeddedRun {
         self.clips += clips as u64;
         let view = LoadView {
             mesh,
+            adjacency: &tracker.adjacency,
             surface: &tracker.surface,
             t: t + dt,
             side: &tracker.sides.side,
