@@ -1,16 +1,20 @@
-//! The node-to-edge adjacency of the fluid mesh (compressed rows), built once per mesh: the
-//! connectivity the flood fills of Alg. 4.1 step 4 and Alg. 4.2 step 5 walk, with each node's
-//! shortest edge (the length scale of the occlusion tolerance).
+//! The node-to-edge and node-to-cell adjacency of the fluid mesh (compressed rows), built once per
+//! mesh: the connectivity the flood fills of Alg. 4.1 step 4 and Alg. 4.2 step 5 walk, with each
+//! node's shortest edge (the length scale of the occlusion tolerance), and the cells around each
+//! node, from which the loads of Alg. 5.3 find the cells around the cut edges.
 
 use crate::mesh::geometry::{norm, sub};
 use crate::mesh::Mesh;
 
-/// For each node, the edges that touch it, ascending.
+/// For each node, the edges and the cells that touch it, ascending.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeEdges {
     /// Node `i`'s edges are `edges[offsets[i]..offsets[i + 1]]`.
     offsets: Vec<u32>,
     edges: Vec<u32>,
+    /// Node `i`'s cells are `cells[cell_offsets[i]..cell_offsets[i + 1]]`.
+    cell_offsets: Vec<u32>,
+    cells: Vec<u32>,
     /// Shortest edge at each node (infinite for a node with no edge).
     pub h_min: Vec<f64>,
 }
@@ -38,7 +42,14 @@ impl NodeEdges {
                 h_min[v] = h_min[v].min(l);
             }
         }
-        NodeEdges { offsets, edges, h_min }
+        let (cell_offsets, cells) = node_cells(mesh);
+        NodeEdges { offsets, edges, cell_offsets, cells, h_min }
+    }
+
+    /// The cells with node `i` among their corners.
+    #[inline]
+    pub fn cells_of(&self, i: usize) -> &[u32] {
+        &self.cells[self.cell_offsets[i] as usize..self.cell_offsets[i + 1] as usize]
     }
 
     /// The edges of node `i`.
@@ -79,7 +90,33 @@ impl NodeEdges {
         std::mem::size_of_val(&self.offsets[..])
             + std::mem::size_of_val(&self.edges[..])
             + std::mem::size_of_val(&self.h_min[..])
+            + std::mem::size_of_val(&self.cell_offsets[..])
+            + std::mem::size_of_val(&self.cells[..])
     }
+}
+
+/// The compressed node-to-cell rows of `mesh` (offsets, cells), each row ascending.
+fn node_cells(mesh: &Mesh) -> (Vec<u32>, Vec<u32>) {
+    let n = mesh.n_nodes();
+    let mut offsets = vec![0u32; n + 1];
+    for cell in &mesh.cells {
+        for &v in cell.nodes() {
+            offsets[v as usize + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        offsets[k + 1] += offsets[k];
+    }
+    let mut fill = offsets.clone();
+    let mut cells = vec![0u32; offsets[n] as usize];
+    // Cells are visited in ascending order, so each row comes out sorted.
+    for (c, cell) in mesh.cells.iter().enumerate() {
+        for &v in cell.nodes() {
+            cells[fill[v as usize] as usize] = c as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    (offsets, cells)
 }
 
 #[cfg(test)]
@@ -104,5 +141,22 @@ mod tests {
         }
         assert!(count.iter().all(|&c| c == 2));
         assert_eq!(adj.h_min, mesh.min_edge_length());
+    }
+
+    #[test]
+    fn every_cell_is_listed_at_each_corner() {
+        let raw = BoxSpec::uniform([0.0; 3], [1.0; 3], [3, 2, 2], BoxCells::Hex).raw().unwrap();
+        let mesh = Mesh::build(raw).unwrap();
+        let adj = NodeEdges::build(&mesh);
+        let mut count = vec![0; mesh.cells.len()];
+        for i in 0..mesh.n_nodes() {
+            let row = adj.cells_of(i);
+            assert!(row.windows(2).all(|w| w[0] < w[1]));
+            for &c in row {
+                assert!(mesh.cells[c as usize].nodes().contains(&(i as u32)));
+                count[c as usize] += 1;
+            }
+        }
+        assert!(count.iter().all(|&c| c == 8), "{count:?}");
     }
 }

@@ -250,6 +250,7 @@ impl EmbeddedRun {
         let tracker = &self.tracker;
         let view = LoadView {
             mesh: &semi.mesh,
+            adjacency: &tracker.adjacency,
             surface: &tracker.surface,
             t: tracker.surface.t_b,
             side: &tracker.sides.side,

@@ -18,6 +18,7 @@
 pub mod facets;
 pub mod reconstructed;
 
+use super::adjacency::NodeEdges;
 use super::riemann_fs::WallPressures;
 use super::{CutEdge, Surface};
 use crate::mesh::Mesh;
@@ -30,10 +31,11 @@ pub use interface_protocol::case::LoadAlgorithm;
 /// What the loads read: the mesh, the surface at the load time `t`, the side of every node (any
 /// two values for the two sides of the surface, as the node status gives them), the cut edges
 /// (sorted by edge) and the `p*` of each side of each cut edge (`NaN` where the side holds no
-/// fluid).
+/// fluid), with the mesh's adjacency (whose node-to-cell rows give the cells around the cuts).
 #[derive(Clone, Copy)]
 pub struct LoadView<'a> {
     pub mesh: &'a Mesh,
+    pub adjacency: &'a NodeEdges,
     pub surface: &'a Surface,
     pub t: f64,
     pub side: &'a [u32],

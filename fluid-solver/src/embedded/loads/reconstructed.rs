@@ -37,23 +37,34 @@ pub(super) fn loads(view: &LoadView, out: &mut [[f64; 3]]) {
 
 /// Calls `sink(x, f, triangle, bary)` for every Gauss point `x` of the reconstructed interface
 /// with its force `f` on the structure and the structure triangle and barycentric coordinates of
-/// its projection.
-pub(super) fn gauss_loads(
+/// its projection. Only the cells around the cut edges are visited, in ascending order.
+pub(super) fn gauss_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3])) {
+    gauss_loads_in(view, &cut_cells(view), sink);
+}
+
+/// The cells holding both ends of some cut edge, ascending: every cell with a cut edge, so every
+/// cell that can hold a polygon.
+pub(super) fn cut_cells(view: &LoadView) -> Vec<u32> {
+    let mut cells = Vec::with_capacity(8 * view.cuts.len());
+    for c in view.cuts {
+        let [i, j] = view.mesh.edges[c.edge as usize];
+        let around = view.adjacency.cells_of(i as usize);
+        cells.extend(around.iter().filter(|&&k| view.mesh.cells[k as usize].nodes().contains(&j)));
+    }
+    cells.sort_unstable();
+    cells.dedup();
+    cells
+}
+
+/// [`gauss_loads`] over the given `cells` (ascending), which must include every cut cell.
+pub(super) fn gauss_loads_in(
     view: &LoadView,
+    cells: &[u32],
     mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
     let mut polygon = Vec::with_capacity(12);
-    // Only cells with a node at the end of a cut edge can be cut.
-    let mut near = vec![false; view.mesh.n_nodes()];
-    for c in view.cuts {
-        for n in view.mesh.edges[c.edge as usize] {
-            near[n as usize] = true;
-        }
-    }
-    for cell in &view.mesh.cells {
-        if !cell.nodes().iter().any(|&n| near[n as usize]) {
-            continue;
-        }
+    for &k in cells {
+        let cell = &view.mesh.cells[k as usize];
         let cut_of = cell_cuts(view, cell);
         if cut_of.iter().flatten().count() < 3 {
             continue;
