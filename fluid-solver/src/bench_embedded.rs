@@ -25,6 +25,7 @@ use crate::flux::FluxScheme;
 use crate::mesh::blocks::Window;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec};
 use crate::mesh::Mesh;
+use crate::reconstruct::limiter::Limiter;
 use crate::riemann::PressureCutoff;
 use interface_protocol::case::Tracking;
 use serde::Serialize;
@@ -231,6 +232,7 @@ fn track(
             &cut,
             prim,
             |_, _| true,
+            true,
         )?;
         let t_fill = start.elapsed().as_secs_f64();
         std::hint::black_box(filled);
@@ -318,6 +320,8 @@ fn wall_flux_cost(
     let materials =
         [WallMaterial { eos: Eos::PerfectGas { gamma: 1.4 }, cutoff: PressureCutoff::OFF }];
     let material = vec![0u8; mesh.n_nodes()];
+    // The second-order interface (the default) with the gradients of the uniform bench state.
+    let grad = vec![[[0.0; 3]; 5]; mesh.n_nodes()];
     let view = WallFluxView {
         mesh,
         surface: &tracker.surface,
@@ -327,6 +331,8 @@ fn wall_flux_cost(
         material: &material,
         materials: &materials,
         prim,
+        grad: Some(&grad),
+        limiter: Limiter::VanAlbada,
     };
     let cuts = &tracker.cuts.cuts;
     anyhow::ensure!(!cuts.is_empty(), "the cylinder cuts no edge of the bench box");

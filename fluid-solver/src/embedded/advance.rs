@@ -13,6 +13,7 @@ use crate::semidiscretization::Semidiscretization;
 use crate::state::{State, Workspace};
 use crate::time::cfl::stable_time_step;
 use crate::time::rk2::rk2_step_embedded;
+use interface_protocol::case::InterfaceTreatment;
 use interface_protocol::io::probes::ProbeWriter;
 use std::path::Path;
 
@@ -94,19 +95,24 @@ impl EmbeddedRun {
             &cut,
             &ws.prim,
             |i, j| material[i] == material[j],
+            self.prescribed.interface == InterfaceTreatment::SecondOrder
+                && semi.numerics.second_order(),
         )?;
         for (i, w) in filled {
             let i = i as usize;
             state.cons[i] = semi.eos_at(i).prim_to_cons(&w);
             ws.prim[i] = w;
         }
-        let step = EmbeddedStep::new(semi, tracker, self.p_cut);
+        let step = EmbeddedStep::new(semi, tracker, self.p_cut, self.prescribed.interface);
         self.tracking_s += start.elapsed().as_secs_f64();
         rk2_step_embedded(semi, state, ws, dt, &step, tracker)?;
         let start = std::time::Instant::now();
         semi.primitives(&state.cons, ws)?;
+        if step.interface == InterfaceTreatment::SecondOrder {
+            step.gradient.compute(mesh, &ws.prim, &mut ws.grad);
+        }
         let wall = Wall { step: &step, tracker, t: t + dt };
-        let (p_star, clips) = wall.pressures(semi, &ws.prim)?;
+        let (p_star, clips) = wall.pressures(semi, &ws.prim, &ws.grad)?;
         self.clips += clips as u64;
         let view = LoadView {
             mesh,

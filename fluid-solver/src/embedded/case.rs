@@ -8,7 +8,9 @@ use super::motion::RigidMotion;
 use super::tracker::{Seed, Tracker};
 use super::Surface;
 use crate::mesh::Mesh;
-use interface_protocol::case::{Case, EmbeddedSurface, FluidEmbedded, LoadAlgorithm};
+use interface_protocol::case::{
+    Case, EmbeddedSurface, FluidEmbedded, InterfaceTreatment, LoadAlgorithm,
+};
 
 /// An embedded surface with its prescribed motion, ready to step.
 #[derive(Debug, Clone)]
@@ -19,6 +21,8 @@ pub struct Prescribed {
     /// Surface node positions at `t = 0`.
     pub reference: Vec<[f64; 3]>,
     pub loads: LoadAlgorithm,
+    /// The states of the cut-edge fluxes (Alg. 5.1, [`super::riemann_fs::interface`]).
+    pub interface: InterfaceTreatment,
 }
 
 impl Prescribed {
@@ -64,7 +68,7 @@ pub fn prescribed(case: &Case, mesh: &Mesh, t0: f64) -> anyhow::Result<Option<Pr
     }
     let tracker = Tracker::new(mesh, surface, e.tracking, &seeds)
         .map_err(|err| field_error(case, "fluid.embedded.seeds", err))?;
-    Ok(Some(Prescribed { tracker, motion, reference: s.x, loads: e.loads }))
+    Ok(Some(Prescribed { tracker, motion, reference: s.x, loads: e.loads, interface: e.interface }))
 }
 
 /// Positions and velocities at `t` of the points whose positions at `t = 0` are `reference`.

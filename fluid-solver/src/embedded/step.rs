@@ -13,6 +13,7 @@ use crate::reconstruct::gradient::LsqGradient;
 use crate::riemann::PressureCutoff;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::special_edges::{SpecialEdge, SpecialEdges, SpecialKind};
+use interface_protocol::case::InterfaceTreatment;
 
 /// The embedded boundary as one step's residuals read it.
 #[derive(Debug, Clone)]
@@ -25,12 +26,20 @@ pub struct EmbeddedStep {
     pub materials: Vec<WallMaterial>,
     /// Number of uncut edges with exactly one active end (taken as slip walls).
     pub frozen_edges: usize,
+    /// The states of the cut-edge fluxes ([`super::riemann_fs::interface`]); the second-order
+    /// form needs the scheme's gradients (a first-order scheme takes the first-order form).
+    pub interface: InterfaceTreatment,
 }
 
 impl EmbeddedStep {
     /// The step's view of `tracker` for the scheme `semi` with the cut-off `p_cut` (Pa; `None`:
-    /// the EOS defaults of [`PressureCutoff`]).
-    pub fn new(semi: &Semidiscretization, tracker: &Tracker, p_cut: Option<f64>) -> EmbeddedStep {
+    /// the EOS defaults of [`PressureCutoff`]) and the interface treatment `interface`.
+    pub fn new(
+        semi: &Semidiscretization,
+        tracker: &Tracker,
+        p_cut: Option<f64>,
+        interface: InterfaceTreatment,
+    ) -> EmbeddedStep {
         let mesh = &semi.mesh;
         let active = &tracker.active;
         let cut = tracker.cuts.cut_mask(mesh.n_edges());
@@ -71,7 +80,11 @@ impl EmbeddedStep {
                 ),
             })
             .collect();
-        EmbeddedStep { special, gradient, materials, frozen_edges }
+        let interface = match semi.numerics.second_order() {
+            true => interface,
+            false => InterfaceTreatment::FirstOrder,
+        };
+        EmbeddedStep { special, gradient, materials, frozen_edges, interface }
     }
 }
 
@@ -84,8 +97,19 @@ pub struct Wall<'a> {
     pub t: f64,
 }
 
+/// Nodal gradients of the primitive states, `grad[i][k] = ∇W_k` at node `i`.
+pub type Gradients = [[[f64; 3]; 5]];
+
 impl Wall<'_> {
-    fn view<'b>(&'b self, semi: &'b Semidiscretization, prim: &'b [[f64; 5]]) -> WallFluxView<'b> {
+    /// The wall fluxes' view of the states `prim` and their gradients `grad` (read only by the
+    /// second-order interface).
+    fn view<'b>(
+        &'b self,
+        semi: &'b Semidiscretization,
+        prim: &'b [[f64; 5]],
+        grad: &'b Gradients,
+    ) -> WallFluxView<'b> {
+        let second_order = self.step.interface == InterfaceTreatment::SecondOrder;
         WallFluxView {
             mesh: &semi.mesh,
             surface: &self.tracker.surface,
@@ -95,6 +119,8 @@ impl Wall<'_> {
             material: semi.material(),
             materials: &self.step.materials,
             prim,
+            grad: second_order.then_some(grad),
+            limiter: semi.numerics.limiter,
         }
     }
 
@@ -105,6 +131,7 @@ impl Wall<'_> {
         semi: &Semidiscretization,
         s: SpecialEdge,
         prim: &[[f64; 5]],
+        grad: &Gradients,
         r: &mut Window<'_, [f64; 5]>,
     ) -> Result<(), FluidError> {
         let mesh = &semi.mesh;
@@ -114,7 +141,7 @@ impl Wall<'_> {
         match s.kind {
             SpecialKind::Cut => {
                 let cut = self.tracker.cuts.find(s.edge).expect("a cut special edge is cut");
-                let view = self.view(semi, prim);
+                let view = self.view(semi, prim, grad);
                 for (end, node) in [(End::I, i), (End::J, j)] {
                     if active[node] {
                         let f = one_sided(&view, cut, end).map_err(FluidError::Wall)?;
@@ -152,14 +179,16 @@ impl Wall<'_> {
         Ok(())
     }
 
-    /// `p*` on both sides of every cut edge from the states `prim` (the loads' input, Alg. 5.3 and
-    /// 5.4), and the number of cavitation clips.
+    /// `p*` on both sides of every cut edge from the states `prim` and their gradients `grad`
+    /// through the step's gradient operator (the loads' input, Alg. 5.3 and 5.4), and the number
+    /// of cavitation clips.
     pub fn pressures(
         &self,
         semi: &Semidiscretization,
         prim: &[[f64; 5]],
+        grad: &Gradients,
     ) -> Result<(Vec<WallPressures>, usize), WallFluxError> {
-        let view = self.view(semi, prim);
+        let view = self.view(semi, prim, grad);
         let mesh = &semi.mesh;
         let mut clips = 0;
         let mut out = Vec::with_capacity(self.tracker.cuts.cuts.len());
