@@ -35,11 +35,12 @@ use crate::flux::FluxScheme;
 use crate::mesh::blocks::Window;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec};
 use crate::mesh::Mesh;
+use crate::reconstruct::limiter::Limiter;
 use crate::riemann::PressureCutoff;
 use crate::semidiscretization::Semidiscretization;
 use crate::state::{State, Workspace};
 use crate::time::cfl::stable_time_step;
-use interface_protocol::case::{LoadAlgorithm, Motion, Tracking};
+use interface_protocol::case::{InterfaceTreatment, LoadAlgorithm, Motion, Tracking};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -209,7 +210,7 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
     let tracker = Tracker::new(mesh, spec.surface.clone(), spec.tracking, &spec.seeds)?;
     let prim: Vec<[f64; 5]> = initial.cons.iter().map(|w| semi.eos[0].cons_to_prim(w)).collect();
     let wall_fluxes = wall_flux_cost(mesh, &tracker, &prim, fluid)?;
-    let step = EmbeddedStep::new(&semi, &tracker, None);
+    let step = EmbeddedStep::new(&semi, &tracker, None, InterfaceTreatment::default());
     let mut split = BTreeMap::new();
     let s = &tracker.surface;
     let surface_bytes = std::mem::size_of_val(&s.triangles[..])
@@ -256,12 +257,13 @@ fn track(
     surface.v_b.clone_from(&surface.v_a);
     let tracker = Tracker::new(mesh, surface, spec.tracking, &spec.seeds)?;
     let mut parts = tracker.clone();
-    let mut parts_step = EmbeddedStep::new(semi, &parts, None);
+    let mut parts_step = EmbeddedStep::new(semi, &parts, None, InterfaceTreatment::default());
     let prescribed = Prescribed {
         tracker,
         motion: Some(RigidMotion::new(Motion::Translation { velocity })),
         reference: spec.surface.x_b.clone(),
         loads: LoadAlgorithm::Reconstructed,
+        interface: InterfaceTreatment::default(),
     };
     let mut run = EmbeddedRun::new(prescribed, None, dir)?;
     // The run's own operator (a run may change the material layout; this one does not).
@@ -320,6 +322,7 @@ fn track(
             &cut,
             &ws.prim,
             |_, _| true,
+            true,
         )?;
         std::hint::black_box(filled);
         stamp("fill", &mut lap);
@@ -351,7 +354,7 @@ fn track(
             };
             full.insert("intersect".to_string(), start.elapsed().as_secs_f64());
             let start = Instant::now();
-            let fresh = EmbeddedStep::new(semi, &parts, None);
+            let fresh = EmbeddedStep::new(semi, &parts, None, InterfaceTreatment::default());
             full.insert("step_new".to_string(), start.elapsed().as_secs_f64());
             anyhow::ensure!(
                 every == parts.cuts && fresh == parts_step,
@@ -410,6 +413,8 @@ fn wall_flux_cost(
     let materials =
         [WallMaterial { eos: Eos::PerfectGas { gamma: 1.4 }, cutoff: PressureCutoff::OFF }];
     let material = vec![0u8; mesh.n_nodes()];
+    // The second-order interface (the default) with the gradients of the uniform bench state.
+    let grad = vec![[[0.0; 3]; 5]; mesh.n_nodes()];
     let view = WallFluxView {
         mesh,
         surface: &tracker.surface,
@@ -419,6 +424,8 @@ fn wall_flux_cost(
         material: &material,
         materials: &materials,
         prim,
+        grad: Some(&grad),
+        limiter: Limiter::VanAlbada,
     };
     let cuts = &tracker.cuts.cuts;
     anyhow::ensure!(!cuts.is_empty(), "the cylinder cuts no edge of the bench box");

@@ -133,7 +133,7 @@ impl Handler<FluidEndpoint> for CoupledFluid<'_> {
                 v_to: v0.clone(),
             };
             let dir = run.out_dir().to_path_buf();
-            let mut e = EmbeddedRun::with(s.tracker, at_rest, s.loads, s.p_cut, &dir)
+            let mut e = EmbeddedRun::with(s.tracker, at_rest, s.loads, s.interface, s.p_cut, &dir)
                 .map_err(solver_failure)?;
             e.start_pressures(run.semidiscretization(), run.primitives())
                 .map_err(solver_failure)?;

@@ -366,7 +366,7 @@ impl Semidiscretization {
                 (SpecialKind::TwoMaterial, _) => {
                     crate::two_phase::edge_flux(self, s.edge as usize, prim, r)?
                 }
-                (_, Some(w)) => w.edge_flux(self, s, prim, r)?,
+                (_, Some(w)) => w.edge_flux(self, s, prim, grad, r)?,
                 (_, None) => unreachable!("cut and frozen edges come with their wall"),
             }
         }

@@ -3,7 +3,10 @@
 //!   exact piston solution on three meshes: the shock speed, `p - p0` and `ρ - ρ0` (the jumps,
 //!   4% of the state) each within 1% on the finest, and the force on the wall equal to `p* A`;
 //! - `cases/harmonic-body`, the thesis' body in harmonic motion, against the exact simple wave on
-//!   four meshes: L1, L2 and Linf pressure errors, their orders, and a committed table.
+//!   four meshes: L1, L2 and Linf pressure errors at the nodes, their orders, and a committed
+//!   table;
+//! - a closed body carried by a uniform flow, and a uniform flow tangential to a tilted wall: both
+//!   stay uniform to round-off.
 
 mod common;
 
@@ -103,35 +106,53 @@ fn piston_air_matches_the_exact_shock_on_three_meshes() {
     assert!(fine < coarse, "the shock speed error must fall with h: {coarse} -> {fine}");
 }
 
-/// Thesis §5.2.3.3 on 80, 160, 320 and 640 cells (limiter on): pressure errors over the fluid at
-/// t = 0.01 (line samples left of the body, one cell clear of it) against the exact simple wave.
-/// The interface of Alg. 5.1 is first order (node states, the wall at the node's facet), and the
-/// observed orders show it: about 1.1 in L1 and L2 and 1.0-1.3 in Linf, where the thesis reports
-/// 1.46 / 1.40 / 1.10 against its finest mesh. The gate here is order >= 1 in every norm, with the
-/// table committed; the 1.4 in L1 of a second-order interface is not reached.
+/// Thesis §5.2.3.3 on 80, 160, 320 and 640 cells (limiter on, the default second-order interface
+/// of `embedded::riemann_fs::interface`): pressure errors at t = 0.01 against the exact simple
+/// wave at the active nodes of the tube's edge line `y = z = -0.225` (a line sample of `cells + 1`
+/// points, each on its node), left of the body by more than one cell. Measured (committed table):
+/// L1 141 / 42.7 / 11.5 / 2.90 Pa, fitted order 1.87 (1.99 on the finest pair); Linf fitted 0.86,
+/// set by the wave's head `x = -c0 t`, where the exact pressure has a kink (the piston starts with
+/// zero velocity and finite acceleration) that the limiter smears ahead of it at first order;
+/// behind the head (`x >= -c0 t + 0.05`) Linf 577 / 227 / 80 / 31 Pa, order 1.4. The first-order
+/// interface (`interface = "first_order"`) measures L1 356 / 126 / 42.6 / 19.4 Pa on the same
+/// nodes.
 #[test]
 fn harmonic_body_converges_to_the_exact_simple_wave() {
     let dir = tempfile::tempdir().unwrap();
     let (r, w) = (0.08, std::f64::consts::TAU * 100.0);
     let piston = move |t: f64| (r * (1.0 - (w * t).cos()), r * w * (w * t).sin());
     let wave = SimpleWave { piston, gamma: 1.4, rho0: 1.3, p0: 1e5 };
+    let head = -(1.4f64 * 1e5 / 1.3).sqrt() * 0.01;
     let cells = [80usize, 160, 320, 640];
     let mut norms = Vec::new();
     for &n in &cells {
         let out = dir.path().join(format!("n{n}"));
-        run_case("harmonic-body", &[format!("fluid.mesh.box.cells=[{n},1,1]")], &out);
-        let line = columns(&out.join("lines/axis_t1.000000e-2.csv"));
+        let line = format!(
+            "fluid.lines=[{{ name = \"nodes\", from = [-4.0, -0.225, -0.225], to = [0.5, -0.225, \
+             -0.225], points = {}, times = [0.01] }}]",
+            n + 1
+        );
+        run_case("harmonic-body", &[format!("fluid.mesh.box.cells=[{n},1,1]"), line], &out);
+        let line = columns(&out.join("lines/nodes_t1.000000e-2.csv"));
         let h = 4.5 / n as f64;
-        let errors: Vec<f64> = (0..line["x"].len())
+        let errors: Vec<(f64, f64)> = (0..line["x"].len())
             .filter(|&k| line["x"][k] < -h)
-            .map(|k| (line["p"][k] - wave.state(line["x"][k], 0.01).unwrap().2).abs())
+            .map(|k| {
+                let x = line["x"][k];
+                (x, (line["p"][k] - wave.state(x, 0.01).unwrap().2).abs())
+            })
             .collect();
         let m = errors.len() as f64;
-        let l1 = errors.iter().sum::<f64>() / m;
-        let l2 = (errors.iter().map(|e| e * e).sum::<f64>() / m).sqrt();
-        let linf = errors.iter().copied().fold(0.0, f64::max);
-        println!("{n} cells: pressure errors L1 {l1:.2} Pa, L2 {l2:.2} Pa, Linf {linf:.1} Pa");
-        norms.push([l1, l2, linf]);
+        let l1 = errors.iter().map(|e| e.1).sum::<f64>() / m;
+        let l2 = (errors.iter().map(|e| e.1 * e.1).sum::<f64>() / m).sqrt();
+        let linf = errors.iter().map(|e| e.1).fold(0.0, f64::max);
+        let behind = errors.iter().filter(|e| e.0 >= head + 0.05).map(|e| e.1);
+        let linf_behind = behind.fold(0.0, f64::max);
+        println!(
+            "{n} cells: pressure errors L1 {l1:.2} Pa, L2 {l2:.2} Pa, Linf {linf:.1} Pa \
+             (behind the head {linf_behind:.1} Pa)"
+        );
+        norms.push([l1, l2, linf, linf_behind]);
     }
     // Least-squares slope of log(error) against log(h) over the four meshes.
     let fit = |k: usize| {
@@ -142,10 +163,19 @@ fn harmonic_body_converges_to_the_exact_simple_wave() {
         let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
         sxy / sxx
     };
-    let orders = [fit(0), fit(1), fit(2)];
-    println!("fitted orders L1 {:.2}, L2 {:.2}, Linf {:.2}", orders[0], orders[1], orders[2]);
-    assert!(orders.iter().all(|&o| o >= 1.0), "orders {orders:?}");
-    let table = serde_json::json!({ "cells": cells, "l1_l2_linf_pa": norms, "orders": orders });
+    let orders = [fit(0), fit(1), fit(2), fit(3)];
+    println!(
+        "fitted orders L1 {:.2}, L2 {:.2}, Linf {:.2}, Linf behind the head {:.2}",
+        orders[0], orders[1], orders[2], orders[3]
+    );
+    assert!(orders[0] >= 1.8 && orders[1] >= 1.4, "L1, L2 orders {orders:?}");
+    assert!(orders[2] >= 0.8 && orders[3] >= 1.3, "Linf orders {orders:?}");
+    let table = serde_json::json!({
+        "cells": cells,
+        "norms": ["l1", "l2", "linf", "linf_behind_head"],
+        "errors_pa": norms,
+        "orders": orders,
+    });
     common::compare_with_reference("harmonic_body.json", &table, 0.05);
 }
 
@@ -210,5 +240,80 @@ checkpoint_every = 0
         println!("{loads}: largest relative deviation {worst:.2e}, largest net force {net:.2e} N (face force {face:.0} N)");
         assert!(worst < 1e-10, "{loads}: the uniform flow is disturbed by {worst:e}");
         assert!(net < 1e-9 * face, "{loads}: net force {net:e} on a closed surface");
+    }
+}
+
+/// A static plane tilted so that its normal lies along no edge of the tet mesh, spanning the box,
+/// fluid on both sides (Alg. 4.2), in a uniform flow parallel to it (DESIGN §8.3): `u·n = 0` at
+/// every cut edge, so Alg. 5.1's wall state is the node state with either interface treatment and
+/// every node keeps the uniform state to round-off.
+#[test]
+fn a_uniform_flow_tangential_to_a_tilted_wall_stays_uniform() {
+    let dir = tempfile::tempdir().unwrap();
+    let unit = |v: [f64; 3]| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        v.map(|c| c / l)
+    };
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    };
+    let n = unit([1.0, 0.43, 0.71]);
+    let a = unit(cross(n, [0.0, 0.0, 1.0]));
+    let b = cross(n, a);
+    let c = [0.503, 0.251, 0.247];
+    let corner: [f64; 3] = std::array::from_fn(|k| c[k] - 2.0 * a[k] - 2.0 * b[k]);
+    let (edge_u, edge_v) = (a.map(|x| 4.0 * x), b.map(|x| 4.0 * x));
+    let u: [f64; 3] = std::array::from_fn(|k| 10.0 * (0.6 * a[k] + 0.8 * b[k]));
+    let w = [1.3, u[0], u[1], u[2], 1e5];
+    let side = |s: f64| -> [f64; 3] { std::array::from_fn(|k| c[k] + s * n[k]) };
+    for interface in ["first_order", "second_order"] {
+        let text = format!(
+            r#"
+[fluid]
+eos = {{ kind = "perfect_gas", gamma = 1.4 }}
+[fluid.mesh]
+box = {{ lo = [0, 0, 0], hi = [1, 0.5, 0.5], cells = [12, 6, 6], shape = "tet" }}
+[fluid.initial]
+state = {w:?}
+[fluid.boundary]
+xmin = {{ kind = "far_field", state = {w:?} }}
+xmax = {{ kind = "far_field", state = {w:?} }}
+ymin = {{ kind = "far_field", state = {w:?} }}
+ymax = {{ kind = "far_field", state = {w:?} }}
+zmin = {{ kind = "far_field", state = {w:?} }}
+zmax = {{ kind = "far_field", state = {w:?} }}
+[fluid.embedded]
+surface = {{ generator = "plate", corner = {corner:?}, edge_u = {edge_u:?}, edge_v = {edge_v:?}, cells = [3, 3] }}
+tracking = "collision"
+interface = "{interface}"
+seeds = [{{ at = {:?}, active = true }}, {{ at = {:?}, active = true }}]
+[fluid.time]
+t_end = 2e-3
+[output]
+fields_every = 0
+checkpoint_every = 0
+"#,
+            side(0.15),
+            side(-0.15)
+        );
+        let path = dir.path().join(format!("{interface}.toml"));
+        std::fs::write(&path, &text).unwrap();
+        let case = Case::load(&path, &[]).unwrap();
+        let out = dir.path().join(interface);
+        let opts = RunOptions { out: out.clone(), quiet: true, restart: None, force: false };
+        let summary = solver::run(&case, &text, &opts).unwrap();
+        let (state, _, _) = solver::read_checkpoint(&out, summary.nodes).unwrap();
+        let eos = Eos::PerfectGas { gamma: 1.4 };
+        let scale = [1.3, 10.0, 10.0, 10.0, 1e5];
+        let mut worst = 0.0f64;
+        for q in &state.cons {
+            let p = eos.cons_to_prim(q);
+            for k in 0..5 {
+                worst = worst.max((p[k] - w[k]).abs() / scale[k]);
+            }
+        }
+        println!("{interface}: {} steps, largest relative deviation {worst:.2e}", summary.steps);
+        assert!(summary.steps > 10);
+        assert!(worst < 1e-12, "{interface}: the tangential flow is disturbed by {worst:e}");
     }
 }

@@ -16,7 +16,7 @@ use super::fill::fill_changed;
 use super::loads::{nodal_loads, LoadView};
 use super::motion::RigidMotion;
 use super::side_fluid::side_materials;
-use super::step::{EmbeddedStep, Wall};
+use super::step::{EmbeddedStep, Gradients, Wall};
 use super::surface::HermitePath;
 use super::tracker::Tracker;
 use crate::mesh::geometry::{cross, norm};
@@ -24,7 +24,7 @@ use crate::semidiscretization::Semidiscretization;
 use crate::state::{State, Workspace};
 use crate::time::cfl::stable_time_step;
 use crate::time::rk2::rk2_step_embedded;
-use interface_protocol::case::LoadAlgorithm;
+use interface_protocol::case::{InterfaceTreatment, LoadAlgorithm};
 use interface_protocol::io::probes::ProbeWriter;
 use std::path::Path;
 
@@ -65,6 +65,8 @@ pub struct EmbeddedRun {
     pub load_algorithm: LoadAlgorithm,
     /// Cavitation cut-off of the case (`None`: each EOS's default).
     pub p_cut: Option<f64>,
+    /// The states of the cut-edge fluxes (Alg. 5.1, [`super::riemann_fs::interface`]).
+    pub interface: InterfaceTreatment,
     /// Nodal loads at the end of the last step, in surface node order.
     pub loads: Vec<[f64; 3]>,
     /// Cavitation clips of `p*` counted in the loads passes.
@@ -81,8 +83,9 @@ impl EmbeddedRun {
     /// The surface of `[fluid.embedded]` with its prescribed motion; opens `surface_forces.csv`
     /// in `dir`.
     pub fn new(prescribed: Prescribed, p_cut: Option<f64>, dir: &Path) -> anyhow::Result<Self> {
-        let Prescribed { tracker, motion, reference, loads } = prescribed;
-        EmbeddedRun::with(tracker, Kinematics::Law { motion, reference }, loads, p_cut, dir)
+        let Prescribed { tracker, motion, reference, loads, interface } = prescribed;
+        let kinematics = Kinematics::Law { motion, reference };
+        EmbeddedRun::with(tracker, kinematics, loads, interface, p_cut, dir)
     }
 
     /// A surface moved by `kinematics`, its loads by `load_algorithm`; opens
@@ -92,6 +95,7 @@ impl EmbeddedRun {
         tracker: Tracker,
         kinematics: Kinematics,
         load_algorithm: LoadAlgorithm,
+        interface: InterfaceTreatment,
         p_cut: Option<f64>,
         dir: &Path,
     ) -> anyhow::Result<Self> {
@@ -106,6 +110,7 @@ impl EmbeddedRun {
             kinematics,
             load_algorithm,
             p_cut,
+            interface,
             loads,
             clips: 0,
             tracking_s: 0.0,
@@ -175,6 +180,7 @@ impl EmbeddedRun {
             &cut,
             &ws.prim,
             |i, j| material[i] == material[j],
+            self.interface == InterfaceTreatment::SecondOrder && semi.numerics.second_order(),
         )?;
         for (i, w) in filled {
             let i = i as usize;
@@ -188,13 +194,16 @@ impl EmbeddedRun {
                 step.update(semi, tracker);
                 step
             }
-            None => EmbeddedStep::new(semi, tracker, self.p_cut),
+            None => EmbeddedStep::new(semi, tracker, self.p_cut, self.interface),
         };
         self.tracking_s += start.elapsed().as_secs_f64();
         rk2_step_embedded(semi, state, ws, dt, &step, tracker)?;
         let start = std::time::Instant::now();
         semi.primitives(&state.cons, ws)?;
-        self.wall_pressures(semi, &step, &ws.prim)?;
+        if step.interface == InterfaceTreatment::SecondOrder {
+            step.gradient.compute(&semi.mesh, &ws.prim, &mut ws.grad);
+        }
+        self.wall_pressures(semi, &step, &ws.prim, &ws.grad)?;
         self.step = Some(step);
         let mut loads = std::mem::take(&mut self.loads);
         // A new topology may add surface nodes.
@@ -214,16 +223,18 @@ impl EmbeddedRun {
         Ok(dt)
     }
 
-    /// `p*` at every cut edge from the primitive states `prim` at the surface's current time
-    /// (`t_b`), kept in the tracker for the loads; counts the cavitation clips.
+    /// `p*` at every cut edge from the primitive states `prim` and their gradients `grad` (read
+    /// by the second-order interface only) at the surface's current time (`t_b`), kept in the
+    /// tracker for the loads; counts the cavitation clips.
     fn wall_pressures(
         &mut self,
         semi: &Semidiscretization,
         step: &EmbeddedStep,
         prim: &[[f64; 5]],
+        grad: &Gradients,
     ) -> anyhow::Result<()> {
         let wall = Wall { step, tracker: &self.tracker, t: self.tracker.surface.t_b };
-        let (p_star, clips) = wall.pressures(semi, prim)?;
+        let (p_star, clips) = wall.pressures(semi, prim, grad)?;
         self.clips += clips as u64;
         self.tracker.p_star = p_star;
         Ok(())
@@ -235,8 +246,12 @@ impl EmbeddedRun {
         semi: &Semidiscretization,
         prim: &[[f64; 5]],
     ) -> anyhow::Result<()> {
-        let step = EmbeddedStep::new(semi, &self.tracker, self.p_cut);
-        self.wall_pressures(semi, &step, prim)
+        let step = EmbeddedStep::new(semi, &self.tracker, self.p_cut, self.interface);
+        let mut grad = vec![[[0.0; 3]; 5]; prim.len()];
+        if step.interface == InterfaceTreatment::SecondOrder {
+            step.gradient.compute(&semi.mesh, prim, &mut grad);
+        }
+        self.wall_pressures(semi, &step, prim, &grad)
     }
 
     /// The nodal loads on the structure (Alg. 5.3 or 5.4, both sides of a shell summed) at the

@@ -13,7 +13,9 @@ use super::motion::RigidMotion;
 use super::tracker::{Seed, Tracker};
 use super::Surface;
 use crate::mesh::Mesh;
-use interface_protocol::case::{Case, EmbeddedSurface, FluidEmbedded, LoadAlgorithm, Tracking};
+use interface_protocol::case::{
+    Case, EmbeddedSurface, FluidEmbedded, InterfaceTreatment, LoadAlgorithm, Tracking,
+};
 
 /// An embedded surface with its prescribed motion, ready to step.
 #[derive(Debug, Clone)]
@@ -24,6 +26,8 @@ pub struct Prescribed {
     /// Surface node positions at `t = 0`.
     pub reference: Vec<[f64; 3]>,
     pub loads: LoadAlgorithm,
+    /// The states of the cut-edge fluxes (Alg. 5.1, [`super::riemann_fs::interface`]).
+    pub interface: InterfaceTreatment,
 }
 
 /// A surface from the structure, tracked as the case says.
@@ -33,6 +37,8 @@ pub struct FromStructure {
     pub loads: LoadAlgorithm,
     /// Cavitation cut-off (`None`: each EOS's default).
     pub p_cut: Option<f64>,
+    /// The states of the cut-edge fluxes (Alg. 5.1).
+    pub interface: InterfaceTreatment,
 }
 
 fn field_error(case: &Case, field: &str, message: impl std::fmt::Display) -> anyhow::Error {
@@ -87,7 +93,7 @@ pub fn prescribed(case: &Case, mesh: &Mesh, t0: f64) -> anyhow::Result<Option<Pr
     surface.t_b = t0;
     let tracker = Tracker::new(mesh, surface, e.tracking, &seeds(case, Some(e), mesh))
         .map_err(|err| field_error(case, "fluid.embedded.seeds", err))?;
-    Ok(Some(Prescribed { tracker, motion, reference: s.x, loads: e.loads }))
+    Ok(Some(Prescribed { tracker, motion, reference: s.x, loads: e.loads, interface: e.interface }))
 }
 
 /// Refuses the keys of `[fluid.embedded]` that only a fluid-alone run reads.
@@ -118,6 +124,7 @@ pub fn from_structure(case: &Case, mesh: &Mesh, surface: Surface) -> anyhow::Res
         tracker,
         loads: e.map_or(LoadAlgorithm::default(), |e| e.loads),
         p_cut: e.and_then(|e| e.p_cut),
+        interface: e.map_or(InterfaceTreatment::default(), |e| e.interface),
     })
 }
 

@@ -2,7 +2,11 @@
 //! each cut edge and each of its end nodes that is an active fluid node, the one-sided
 //! fluid-structure Riemann problem along the wall normal oriented from that node, with the node's
 //! own EOS and cavitation cut-off, gives the wall state `W* = (ρ*, w_n n + v_i - (v_i·n) n, p*)`
-//! and the flux `F(W_i, W*, EOS_i, ±ν_ij)` through the scheme of the ordinary edges.
+//! and the flux `F(W_i, W*, EOS_i, ±ν_ij)` through the scheme of the ordinary edges. That is the
+//! thesis' first-order form (`interface = "first_order"`); the default second-order form
+//! ([`interface`], after Main, Zeng, Avery & Farhat 2017) solves the problem at the intersection
+//! point from the node state reconstructed there and takes the flux from states on the line
+//! through the star state, evaluated at the facet.
 //!
 //! Signs: the ordinary loop adds `F_ij` to `R_i` and subtracts it from `R_j`. Here each end gets
 //! the flux *leaving its own dual cell*: node `i` through `+ν_ij`, node `j` through `-ν_ij`, and
@@ -15,6 +19,7 @@ use crate::flux::{numerical_flux, FluxScheme};
 use crate::mesh::blocks::Window;
 use crate::mesh::geometry::{dot, norm, sub};
 use crate::mesh::Mesh;
+use crate::reconstruct::limiter::Limiter;
 use crate::riemann::{fluid_structure_with_cutoff, PressureCutoff, RiemannError};
 use std::ops::Range;
 
@@ -45,6 +50,11 @@ pub struct WallFluxView<'a> {
     pub material: &'a [u8],
     pub materials: &'a [WallMaterial],
     pub prim: &'a [[f64; 5]],
+    /// The nodal gradients of `prim` through same-side, same-fluid edges: `Some` selects the
+    /// second-order interface of [`interface`], `None` the thesis' first-order form.
+    pub grad: Option<&'a [[[f64; 3]; 5]]>,
+    /// The limiter of the ordinary edges (the second-order form limits its node-side state).
+    pub limiter: Limiter,
 }
 
 /// `p*` on the two sides of a cut edge: `[side of i, side of j]`, `NaN` where the end is inactive.
@@ -107,7 +117,8 @@ pub fn wall_normal_from_i(n_e: [f64; 3], d_ij: [f64; 3], nu_ij: [f64; 3]) -> [f6
     n_e.map(|c| sign * c)
 }
 
-/// Alg. 5.1 for one end of one cut edge (the end must be an active node).
+/// Alg. 5.1 for one end of one cut edge (the end must be an active node): with gradients in the
+/// view, the second-order form of [`interface`]; without, the thesis' form, `F(W_i, W*(W_i), ν)`.
 pub fn one_sided(view: &WallFluxView, cut: &CutEdge, end: End) -> Result<OneSided, WallFluxError> {
     let mesh = view.mesh;
     let e = cut.edge as usize;
@@ -115,36 +126,61 @@ pub fn one_sided(view: &WallFluxView, cut: &CutEdge, end: End) -> Result<OneSide
     let d = sub(mesh.coords[j as usize], mesh.coords[i as usize]);
     let nu = mesh.edge_normals[e];
     let n_i = wall_normal_from_i(cut.normal, d, nu);
-    let (node, n_wall, facet) = match end {
-        End::I => (i, n_i, nu),
-        End::J => (j, n_i.map(|c| -c), nu.map(|c| -c)),
+    let (node, n_wall, facet, towards) = match end {
+        End::I => (i, n_i, nu, d),
+        End::J => (j, n_i.map(|c| -c), nu.map(|c| -c), d.map(|c| -c)),
     };
-    // Step 1: the wall velocity at the intersection point at the stage time.
-    let (_, w) = view.surface.point_at(cut.triangle as usize, cut.bary, view.t);
-    let wi = &view.prim[node as usize];
+    // Step 1: the wall's point and velocity at the intersection at the stage time.
+    let (x_wall, w) = view.surface.point_at(cut.triangle as usize, cut.bary, view.t);
     let mat = &view.materials[view.material[node as usize] as usize];
-    let u_n = wi[1] * n_wall[0] + wi[2] * n_wall[1] + wi[3] * n_wall[2];
+    let wi = &view.prim[node as usize];
     let w_n = dot(w, n_wall);
-    // Step 2: the one-sided problem (Eq. 5.2-5.7) with the node's EOS and cut-off.
-    let star = fluid_structure_with_cutoff(&mat.eos, wi[0], u_n, wi[4], w_n, mat.cutoff).map_err(
-        |source| WallFluxError {
-            edge: cut.edge,
-            i,
-            j,
-            node,
-            position: mesh.coords[node as usize],
-            triangle: cut.triangle,
-            element: view.surface.element_of[cut.triangle as usize],
-            source,
-        },
-    )?;
-    // Step 3: W* keeps the node's tangential velocity, its normal velocity is the wall's.
-    let dv = w_n - u_n;
-    let (rho, p) = (star.state.rho, star.state.p);
-    let w_star = [rho, wi[1] + dv * n_wall[0], wi[2] + dv * n_wall[1], wi[3] + dv * n_wall[2], p];
-    // Step 4: the numerical flux of the ordinary edges (Eq. 5.8).
-    let flux = numerical_flux(view.scheme, &mat.eos, wi, &w_star, &facet);
-    Ok(OneSided { flux, rho, p, clipped: star.clipped })
+    // Steps 2-3: the one-sided problem (Eq. 5.2-5.7) from a state `W` with the node's EOS and
+    // cut-off; `W*` keeps the tangential velocity of `W`, its normal velocity is the wall's.
+    let star = |w_in: &[f64; 5]| -> Result<Star, WallFluxError> {
+        let u_n = w_in[1] * n_wall[0] + w_in[2] * n_wall[1] + w_in[3] * n_wall[2];
+        let s = fluid_structure_with_cutoff(&mat.eos, w_in[0], u_n, w_in[4], w_n, mat.cutoff)
+            .map_err(|source| WallFluxError {
+                edge: cut.edge,
+                i,
+                j,
+                node,
+                position: mesh.coords[node as usize],
+                triangle: cut.triangle,
+                element: view.surface.element_of[cut.triangle as usize],
+                source,
+            })?;
+        let dv = w_n - u_n;
+        let (rho, p) = (s.state.rho, s.state.p);
+        let w =
+            [rho, w_in[1] + dv * n_wall[0], w_in[2] + dv * n_wall[1], w_in[3] + dv * n_wall[2], p];
+        Ok(Star { w, clipped: s.clipped })
+    };
+    // Step 4: the numerical flux of the ordinary edges (Eq. 5.8), from the node side's state and
+    // the wall side's.
+    let (left, right, s) = match view.grad {
+        None => {
+            let s = star(wi)?;
+            (*wi, s.w, s)
+        }
+        Some(grad) => {
+            let x_node = mesh.coords[node as usize];
+            let alpha = interface::wall_fraction(x_node, towards, n_wall, x_wall, cut, end);
+            let g = &grad[node as usize];
+            interface::facet_states(view.limiter, &mat.eos, wi, g, towards, alpha, star)?
+        }
+    };
+    let flux = numerical_flux(view.scheme, &mat.eos, &left, &right, &facet);
+    Ok(OneSided { flux, rho: s.w[0], p: s.w[4], clipped: s.clipped })
+}
+
+/// A wall state of the one-sided problem.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Star {
+    /// `W* = [ρ*, v + (w_n - v·n) n, p*]`.
+    pub w: [f64; 5],
+    /// The cavitation cut-off set `p* = p_cut`.
+    pub clipped: bool,
 }
 
 /// The cut edges (indices into `cuts`, sorted by edge) whose edges lie in `edges` (a block's).
@@ -185,5 +221,6 @@ pub fn add_wall_fluxes(
     Ok(clips)
 }
 
+pub mod interface;
 #[cfg(test)]
 mod tests;

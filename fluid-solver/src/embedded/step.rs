@@ -14,6 +14,7 @@ use crate::reconstruct::gradient::LsqGradient;
 use crate::riemann::PressureCutoff;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::special_edges::{SpecialEdge, SpecialEdges, SpecialKind};
+use interface_protocol::case::InterfaceTreatment;
 
 /// The embedded boundary as one step's residuals read it.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,6 +32,9 @@ pub struct EmbeddedStep {
     active: Vec<bool>,
     cut: Vec<u32>,
     frozen: Vec<u32>,
+    /// The states of the cut-edge fluxes ([`super::riemann_fs::interface`]); the second-order
+    /// form needs the scheme's gradients (a first-order scheme takes the first-order form).
+    pub interface: InterfaceTreatment,
 }
 
 /// Whether edge `e` is cut, from the sorted cut list.
@@ -40,8 +44,13 @@ fn is_cut(cut: &[u32], e: u32) -> bool {
 
 impl EmbeddedStep {
     /// The step's view of `tracker` for the scheme `semi` with the cut-off `p_cut` (Pa; `None`:
-    /// the EOS defaults of [`PressureCutoff`]).
-    pub fn new(semi: &Semidiscretization, tracker: &Tracker, p_cut: Option<f64>) -> EmbeddedStep {
+    /// the EOS defaults of [`PressureCutoff`]) and the interface treatment `interface`.
+    pub fn new(
+        semi: &Semidiscretization,
+        tracker: &Tracker,
+        p_cut: Option<f64>,
+        interface: InterfaceTreatment,
+    ) -> EmbeddedStep {
         let mesh = &semi.mesh;
         let cut: Vec<u32> = tracker.cuts.cuts.iter().map(|c| c.edge).collect();
         let active = tracker.active.clone();
@@ -68,6 +77,10 @@ impl EmbeddedStep {
                 ),
             })
             .collect();
+        let interface = match semi.numerics.second_order() {
+            true => interface,
+            false => InterfaceTreatment::FirstOrder,
+        };
         let special = special_edges(semi, &frozen, &cut);
         EmbeddedStep {
             special,
@@ -77,6 +90,7 @@ impl EmbeddedStep {
             active,
             cut,
             frozen,
+            interface,
         }
     }
 
@@ -170,8 +184,19 @@ pub struct Wall<'a> {
     pub t: f64,
 }
 
+/// Nodal gradients of the primitive states, `grad[i][k] = ∇W_k` at node `i`.
+pub type Gradients = [[[f64; 3]; 5]];
+
 impl Wall<'_> {
-    fn view<'b>(&'b self, semi: &'b Semidiscretization, prim: &'b [[f64; 5]]) -> WallFluxView<'b> {
+    /// The wall fluxes' view of the states `prim` and their gradients `grad` (read only by the
+    /// second-order interface).
+    fn view<'b>(
+        &'b self,
+        semi: &'b Semidiscretization,
+        prim: &'b [[f64; 5]],
+        grad: &'b Gradients,
+    ) -> WallFluxView<'b> {
+        let second_order = self.step.interface == InterfaceTreatment::SecondOrder;
         WallFluxView {
             mesh: &semi.mesh,
             surface: &self.tracker.surface,
@@ -181,6 +206,8 @@ impl Wall<'_> {
             material: semi.material(),
             materials: &self.step.materials,
             prim,
+            grad: second_order.then_some(grad),
+            limiter: semi.numerics.limiter,
         }
     }
 
@@ -191,6 +218,7 @@ impl Wall<'_> {
         semi: &Semidiscretization,
         s: SpecialEdge,
         prim: &[[f64; 5]],
+        grad: &Gradients,
         r: &mut Window<'_, [f64; 5]>,
     ) -> Result<(), FluidError> {
         let mesh = &semi.mesh;
@@ -200,7 +228,7 @@ impl Wall<'_> {
         match s.kind {
             SpecialKind::Cut => {
                 let cut = self.tracker.cuts.find(s.edge).expect("a cut special edge is cut");
-                let view = self.view(semi, prim);
+                let view = self.view(semi, prim, grad);
                 for (end, node) in [(End::I, i), (End::J, j)] {
                     if active[node] {
                         let f = one_sided(&view, cut, end).map_err(FluidError::Wall)?;
@@ -238,14 +266,16 @@ impl Wall<'_> {
         Ok(())
     }
 
-    /// `p*` on both sides of every cut edge from the states `prim` (the loads' input, Alg. 5.3 and
-    /// 5.4), and the number of cavitation clips.
+    /// `p*` on both sides of every cut edge from the states `prim` and their gradients `grad`
+    /// through the step's gradient operator (the loads' input, Alg. 5.3 and 5.4), and the number
+    /// of cavitation clips.
     pub fn pressures(
         &self,
         semi: &Semidiscretization,
         prim: &[[f64; 5]],
+        grad: &Gradients,
     ) -> Result<(Vec<WallPressures>, usize), WallFluxError> {
-        let view = self.view(semi, prim);
+        let view = self.view(semi, prim, grad);
         let mesh = &semi.mesh;
         let mut clips = 0;
         let mut out = Vec::with_capacity(self.tracker.cuts.cuts.len());
@@ -336,7 +366,8 @@ mod tests {
         ];
         for (label, rest, tracking, seeds, shift) in cases {
             let mut tracker = Tracker::new(mesh, rest.clone(), tracking, &seeds).unwrap();
-            let mut step = EmbeddedStep::new(&semi, &tracker, Some(10.0));
+            let mut step =
+                EmbeddedStep::new(&semi, &tracker, Some(10.0), InterfaceTreatment::SecondOrder);
             let mut flipped_nodes = 0;
             for k in 1..=6 {
                 let f = k as f64;
@@ -346,7 +377,8 @@ mod tests {
                 tracker.advance(mesh, 0.01 * f, &x, &v).unwrap();
                 let before = step.gradient.clone();
                 step.update(&semi, &tracker);
-                let fresh = EmbeddedStep::new(&semi, &tracker, Some(10.0));
+                let fresh =
+                    EmbeddedStep::new(&semi, &tracker, Some(10.0), InterfaceTreatment::SecondOrder);
                 assert_bitwise(&step, &fresh, &format!("{label}, step {k}"));
                 assert!(step.special.all().iter().any(|s| s.kind == SpecialKind::Cut));
                 let (mut g1, mut g2) =

@@ -77,7 +77,7 @@ pub fn reconstruct(
 /// Density positive and pressure above the EOS floor where the flux stays defined
 /// (Tait: density positive; cavitation is the node update's concern, not the flux's).
 #[inline(always)]
-fn admissible(eos: &Eos, w: &[f64; 5]) -> bool {
+pub(crate) fn admissible(eos: &Eos, w: &[f64; 5]) -> bool {
     let (_, pi) = eos.stiffness();
     w[0] > 0.0 && w[4] + pi > 0.0
 }

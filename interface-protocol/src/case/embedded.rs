@@ -19,6 +19,7 @@
 //! # or { kind = "tabulated", times = [0, 1e-3], displacements = [[0, 0, 0], [1e-3, 0, 0]] }
 //! tracking = "collision"   # Alg. 4.2 (default; open, thin surfaces) or "projection" (Alg. 4.1)
 //! loads = "reconstructed"  # Alg. 5.3 (default) or "facets" (Alg. 5.4)
+//! interface = "second_order" # Alg. 5.1 at the reconstructed interface (default) or "first_order"
 //! seeds = [{ at = [0, 0, 0], active = false }]   # flood-fill seeds at t = 0
 //! ```
 //!
@@ -42,6 +43,8 @@ pub struct FluidEmbedded {
     pub tracking: Tracking,
     #[serde(default)]
     pub loads: LoadAlgorithm,
+    #[serde(default)]
+    pub interface: InterfaceTreatment,
     #[serde(default)]
     pub seeds: Vec<Seed>,
     /// Cavitation cut-off: star and nodal pressures below it are clipped to it (Pa).
@@ -169,6 +172,19 @@ pub enum LoadAlgorithm {
     Reconstructed,
     /// Alg. 5.4: control-volume facets.
     Facets,
+}
+
+/// Where the cut-edge fluxes of Alg. 5.1 take their states (thesis Alg. 5.1; Main, Zeng, Avery &
+/// Farhat 2017).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InterfaceTreatment {
+    /// The node state, the wall state at the node's facet (the thesis' form).
+    FirstOrder,
+    /// The node state reconstructed to the intersection point, the flux from states on the line
+    /// through the wall's star state.
+    #[default]
+    SecondOrder,
 }
 
 /// A flood-fill seed: the node nearest `at` and every node reached from it without crossing the
@@ -348,6 +364,9 @@ mod tests {
         );
         assert_eq!(e.surface, Some(EmbeddedSurface::File { file: "plate.msh".into() }));
         assert_eq!(e.loads, LoadAlgorithm::Facets);
+        assert_eq!(e.interface, InterfaceTreatment::SecondOrder);
+        let e = embedded("surface = { file = \"p.msh\" }\ninterface = \"first_order\"\n");
+        assert_eq!(e.interface, InterfaceTreatment::FirstOrder);
         assert_eq!(
             e.motion,
             Some(Motion::Harmonic {

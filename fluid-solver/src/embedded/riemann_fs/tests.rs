@@ -43,6 +43,8 @@ fn view<'a>(
         material,
         materials,
         prim,
+        grad: None,
+        limiter: Limiter::VanAlbada,
     }
 }
 
@@ -218,4 +220,64 @@ fn wall_normal_orientation_rule() {
     assert_eq!(wall_normal_from_i(n_e, [0.0, 0.0, -2.0], [0.0, 0.0, -1.0]), [0.0, 0.0, -1.0]);
     assert_eq!(wall_normal_from_i(n_e, [1.0, 0.0, 1e-10], [0.0, 0.0, -1.0]), [0.0, 0.0, -1.0]);
     assert_eq!(wall_normal_from_i(n_e, [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]), n_e);
+}
+
+/// The second-order interface on a linear field whose velocity at the wall is the wall's: the
+/// wall state is the field at the intersection, so both facet states are the field at the edge
+/// midpoint and the flux is its physical flux, for walls before and beyond the midpoint and from
+/// both ends; the first-order form is off by the field's change over half an edge. A uniform
+/// state the wall moves with gives the physical flux to round-off.
+#[test]
+fn second_order_interface_is_exact_for_linear_fields() {
+    let mesh = cube();
+    let n = mesh.n_nodes();
+    let (mats, material, active) = (air(), vec![0u8; n], vec![true; n]);
+    let g = [[0.2, 0.0, 0.0], [40.0, 0.0, 0.0], [0.0; 3], [0.0; 3], [2e4, 0.0, 0.0]];
+    let field =
+        |x: [f64; 3]| [1.2 + g[0][0] * x[0], 5.0 + g[1][0] * x[0], 0.7, -0.4, 1e5 + g[4][0] * x[0]];
+    let prim: Vec<[f64; 5]> = mesh.coords.iter().map(|&x| field(x)).collect();
+    let grad = vec![g; n];
+    for x_wall in [0.1, 0.2, 0.35, 0.45] {
+        let u_wall = field([x_wall, 0.0, 0.0])[1];
+        let surface =
+            plane([x_wall, 0.5, 0.5], [0.0, 0.7, 0.0], [0.0, 0.0, 0.7], [u_wall, 0.3, -0.2]);
+        let cuts = brute_force_cuts(&mesh, &surface, 0.0);
+        assert_eq!(cuts.len(), 9);
+        let mut v = view(&mesh, &surface, &prim, &active, &mats, &material);
+        v.grad = Some(&grad);
+        let first = view(&mesh, &surface, &prim, &active, &mats, &material);
+        for cut in &cuts {
+            let [i, j] = mesh.edges[cut.edge as usize];
+            let (xi, xj) = (mesh.coords[i as usize], mesh.coords[j as usize]);
+            let mid: [f64; 3] = std::array::from_fn(|k| 0.5 * (xi[k] + xj[k]));
+            let nu = mesh.edge_normals[cut.edge as usize];
+            let scale = 1e5 * norm(nu);
+            for (end, facet) in [(End::I, nu), (End::J, nu.map(|c| -c))] {
+                let s = one_sided(&v, cut, end).unwrap();
+                let exact = physical_flux(&AIR, &field(mid), &facet);
+                let wall = field([x_wall, 0.0, 0.0]);
+                assert!((s.p - wall[4]).abs() < 1e-9 * 1e5, "p* {} at {x_wall}", s.p);
+                for k in 0..5 {
+                    assert!((s.flux[k] - exact[k]).abs() < 1e-11 * scale, "{x_wall} {end:?} {k}");
+                }
+                let f1 = one_sided(&first, cut, end).unwrap();
+                assert!((f1.flux[1] - exact[1]).abs() > 1e-4 * scale, "{x_wall} {end:?}");
+            }
+        }
+    }
+    // A uniform state moving with the wall: W* = W_i and the physical flux, to round-off.
+    let w = [1.3, 10.0, 0.0, 0.0, 1e5];
+    let prim = vec![w; n];
+    let zero = vec![[[0.0; 3]; 5]; n];
+    let surface = plane([0.3, 0.5, 0.5], [0.0, 0.7, 0.0], [0.0, 0.0, 0.7], [10.0, 0.0, 0.0]);
+    let mut v = view(&mesh, &surface, &prim, &active, &mats, &material);
+    v.grad = Some(&zero);
+    for cut in &brute_force_cuts(&mesh, &surface, 0.0) {
+        let nu = mesh.edge_normals[cut.edge as usize];
+        let s = one_sided(&v, cut, End::I).unwrap();
+        let exact = physical_flux(&AIR, &w, &nu);
+        for k in 0..5 {
+            assert!((s.flux[k] - exact[k]).abs() <= 1e-12 * 1e5 * norm(nu), "{k}");
+        }
+    }
 }
