@@ -125,7 +125,7 @@ impl Surface {
             let edge = [ab, ac, bc].map(|e| dot(e, e)).into_iter().fold(0.0, f64::max);
             let n = cross(ab, ac);
             let twice_area = dot(n, n).sqrt();
-            if !(twice_area > 2.0 * DEGENERATE_AREA * edge) {
+            if twice_area.is_nan() || twice_area <= 2.0 * DEGENERATE_AREA * edge {
                 return Err(SurfaceError::Degenerate {
                     element: self.element_of[t],
                     corners: *corners,
