@@ -19,19 +19,52 @@ pub fn rk2_step(
     stepping: TimeStepping,
     dt_max: f64,
 ) -> Result<f64, FluidError> {
-    let dt_min = stable_time_step(semi, &state.cons, ws)?;
-    let dt_global = (stepping.cfl() * dt_min).min(dt_max);
-    let local = matches!(stepping, TimeStepping::Local { .. });
-    let cfl = stepping.cfl();
-    let dt_node = std::mem::take(&mut ws.dt_node);
-    // Δt_i / |C_i|.
-    let ratio = |i: usize| {
-        let dt = if local { (cfl * dt_node[i]).min(dt_max) } else { dt_global };
+    let steps = NodeSteps::new(semi, &state.cons, ws, stepping, dt_max)?;
+    let result = stages(semi, &mut state.cons, ws, |i| steps.ratio(semi, i), None, |_, _| {});
+    steps.finish(ws, result)
+}
+
+/// The CFL steps of one explicit step: the global step no longer than `dt_max` and, for
+/// local stepping, each node's own (held out of `ws.dt_node` while the stages run).
+struct NodeSteps {
+    dt_global: f64,
+    local: bool,
+    cfl: f64,
+    dt_max: f64,
+    dt_node: Vec<f64>,
+}
+
+impl NodeSteps {
+    fn new(
+        semi: &Semidiscretization,
+        cons: &[[f64; 5]],
+        ws: &mut Workspace,
+        stepping: TimeStepping,
+        dt_max: f64,
+    ) -> Result<NodeSteps, FluidError> {
+        let dt_min = stable_time_step(semi, cons, ws)?;
+        Ok(NodeSteps {
+            dt_global: (stepping.cfl() * dt_min).min(dt_max),
+            local: matches!(stepping, TimeStepping::Local { .. }),
+            cfl: stepping.cfl(),
+            dt_max,
+            dt_node: std::mem::take(&mut ws.dt_node),
+        })
+    }
+
+    /// `Δt_i / |C_i|`.
+    #[inline]
+    fn ratio(&self, semi: &Semidiscretization, i: usize) -> f64 {
+        let dt =
+            if self.local { (self.cfl * self.dt_node[i]).min(self.dt_max) } else { self.dt_global };
         dt / semi.mesh.volumes[i]
-    };
-    let result = stages(semi, &mut state.cons, ws, ratio, None, |_, _| {});
-    ws.dt_node = dt_node;
-    result.map(|()| dt_global)
+    }
+
+    /// Gives `ws.dt_node` back; the global step taken when the stages succeeded.
+    fn finish(self, ws: &mut Workspace, result: Result<(), FluidError>) -> Result<f64, FluidError> {
+        ws.dt_node = self.dt_node;
+        result.map(|()| self.dt_global)
+    }
 }
 
 /// [`rk2_step`] of the flow and the level set together (thesis Eq. 3.8 with 3.10-3.13): each
@@ -48,15 +81,8 @@ pub fn rk2_step_level_set(
     stepping: TimeStepping,
     dt_max: f64,
 ) -> Result<f64, FluidError> {
-    let dt_min = stable_time_step(semi, &state.cons, ws)?;
-    let dt_global = (stepping.cfl() * dt_min).min(dt_max);
-    let local = matches!(stepping, TimeStepping::Local { .. });
-    let cfl = stepping.cfl();
-    let dt_node = std::mem::take(&mut ws.dt_node);
-    let ratio = |i: usize| {
-        let dt = if local { (cfl * dt_node[i]).min(dt_max) } else { dt_global };
-        dt / semi.mesh.volumes[i]
-    };
+    let steps = NodeSteps::new(semi, &state.cons, ws, stepping, dt_max)?;
+    let ratio = |i: usize| steps.ratio(semi, i);
     let mut phi_stage = std::mem::take(&mut lws.stage);
     let State { cons, phi, .. } = state;
     let phi_n = &phi[..];
@@ -64,42 +90,32 @@ pub fn rk2_step_level_set(
     let mesh = &semi.mesh;
     // `ws.prim` holds the primitives of the stage's flow state when each stage's flow pass ends.
     let result = stages(semi, cons, ws, ratio, None, |stage, ws| {
-        if stage == 0 {
-            for (s, p) in lws.phi.iter_mut().zip(phi_n) {
-                s[0] = *p;
-            }
-            advect::residual_and_update(
-                mesh,
-                &ls.gradient,
-                limiter,
-                &ls.open,
-                &ws.prim,
-                lws,
-                &mut phi_stage,
-                |i, r, p1| *p1 = phi_n[i] - ratio(i) * r,
-            );
-        } else {
-            for (s, p) in lws.phi.iter_mut().zip(&phi_stage) {
-                s[0] = *p;
-            }
-            advect::residual_and_update(
-                mesh,
-                &ls.gradient,
-                limiter,
-                &ls.open,
-                &ws.prim,
-                lws,
-                &mut phi_stage,
-                |i, r, p| *p = 0.5 * phi_n[i] + 0.5 * (*p - ratio(i) * r),
-            );
+        // The stage's φ (φⁿ, then φ¹) into the advection workspace.
+        let source: &[f64] = if stage == 0 { phi_n } else { &phi_stage };
+        for (s, p) in lws.phi.iter_mut().zip(source) {
+            s[0] = *p;
         }
+        advect::residual_and_update(
+            mesh,
+            &ls.gradient,
+            limiter,
+            &ls.open,
+            &ws.prim,
+            lws,
+            &mut phi_stage,
+            |i, r, p| {
+                *p = match stage {
+                    0 => phi_n[i] - ratio(i) * r,
+                    _ => 0.5 * phi_n[i] + 0.5 * (*p - ratio(i) * r),
+                }
+            },
+        );
     });
-    ws.dt_node = dt_node;
     if result.is_ok() {
         std::mem::swap(phi, &mut phi_stage);
     }
     lws.stage = phi_stage;
-    result.map(|()| dt_global)
+    steps.finish(ws, result)
 }
 
 /// One RK2 step of exactly `dt` from `t_a = tracker.surface.t_a` to `t_b = t_a + dt` with the
