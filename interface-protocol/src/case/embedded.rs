@@ -365,8 +365,8 @@ mod tests {
         assert_eq!(e.surface, Some(EmbeddedSurface::File { file: "plate.msh".into() }));
         assert_eq!(e.loads, LoadAlgorithm::Facets);
         assert_eq!(e.interface, InterfaceTreatment::SecondOrder);
-        let e = embedded("surface = { file = \"p.msh\" }\ninterface = \"first_order\"\n");
-        assert_eq!(e.interface, InterfaceTreatment::FirstOrder);
+        let first = embedded("surface = { file = \"p.msh\" }\ninterface = \"first_order\"\n");
+        assert_eq!(first.interface, InterfaceTreatment::FirstOrder);
         assert_eq!(
             e.motion,
             Some(Motion::Harmonic {
