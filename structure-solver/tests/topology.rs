@@ -330,3 +330,114 @@ fn implicit_steps_follow_a_change_and_leave_the_plate_unchanged() {
     // velocities (rotations included) differ by Newton's tolerance through `2 Δu / Δt`
     assert!(verr <= 1e-5 * vmax, "the plate's velocity moved by {verr:e} m/s (max {vmax:e})");
 }
+
+/// The plate's quads split along their diagonal from the first node: BLT3 shells of a `bt4`
+/// part, clamped at `x = 0`.
+fn triangle_plate(mesh: &Mesh) -> FeModel {
+    let mut split = mesh.clone();
+    split.cells = mesh
+        .cells
+        .iter()
+        .flat_map(|c| {
+            let n = &c.nodes;
+            if c.kind != CellKind::Quad4 {
+                return vec![c.clone()];
+            }
+            [[n[0], n[1], n[2]], [n[0], n[2], n[3]]]
+                .map(|t| Cell { kind: CellKind::Tri3, nodes: t.to_vec() })
+                .to_vec()
+        })
+        .collect();
+    let mut m = FeModel::new(&split, |_| Part::Bt4(SEC, Some(YIELD))).unwrap();
+    m.set_rotary_inertia(RotaryInertia::Scaled);
+    m.fix(mesh.node_set("u0").unwrap(), [true; 6]);
+    m
+}
+
+/// Positions, rotations, spins, the BLT3 state and the lumped masses, bitwise.
+fn triangle_bits(m: &FeModel) -> Vec<u64> {
+    let mut all = bits(m.positions().iter().flat_map(|p| [p.x, p.y, p.z]));
+    all.extend(bits(m.rotations().iter().flat_map(|r| r.as_slice().to_vec())));
+    all.extend(bits(m.committed_spins().iter().flat_map(|p| [p.x, p.y, p.z])));
+    let s = m.blt3().unwrap().state();
+    all.extend(bits(s.stress.iter().chain(&s.alpha).chain(&s.shear).copied()));
+    all.extend(bits(m.lumped_mass().iter().copied()));
+    all
+}
+
+/// BLT3 triangles are copied like BT4 quads: a phantom copy of triangle 6 (nodes 3, 4, 13) on
+/// two new nodes at t = 0 runs bitwise as the model built with it, past yield; a copy made
+/// mid-run onto new nodes survives a checkpoint and restart bitwise.
+#[test]
+fn triangles_are_copied_with_their_state_and_restart_across_the_change() {
+    let base = mesh();
+    let mut a = triangle_plate(&base);
+    a.duplicate_nodes(&[(3, 100), (4, 101)]).unwrap();
+    let copy = a.duplicate_element(6, 500, &[100, 101, 13]).unwrap();
+    assert_eq!(a.topology().store(copy), Some(Store::Blt3(32)));
+    // the model built with the copy: the split plate and the copy's triangle after it
+    let mut union = base.clone();
+    union.nodes.extend([base.nodes[3], base.nodes[4]]);
+    union.cells.push(Cell { kind: CellKind::Tri3, nodes: vec![27, 28, 13] });
+    let mut b = triangle_plate(&union);
+    assert_eq!(a.constrained(), b.constrained(), "free dofs");
+    assert_eq!(a.stable_dt().to_bits(), b.stable_dt().to_bits(), "element step bound");
+    let dt = 0.5 * b.stable_dt();
+    let (va, vb) = (bending_velocity(&a), bending_velocity(&b));
+    let mut ia = CentralDifference::new(&mut a, 0.0, va, None);
+    let mut ib = CentralDifference::new(&mut b, 0.0, vb, None);
+    for _ in 0..300 {
+        ia.step(&mut a, dt, None);
+        ib.step(&mut b, dt, None);
+    }
+    let shells = a.blt3().unwrap();
+    assert!((0..5).any(|p| shells.plastic_strain(6, p) > 0.0), "the triangles yield");
+    assert!(shells.stress(32, 0)[0] != 0.0, "the copy is strained");
+    assert!(triangle_bits(&a) == triangle_bits(&b), "model state differs from the built union");
+    assert!(dynamics_bits(&ia.state) == dynamics_bits(&ib.state), "motion differs");
+
+    // mid-run: a copy of triangle 6 on new nodes, with its source's state, then a restart
+    let mut m = triangle_plate(&base);
+    let v0 = bending_velocity(&m);
+    let mut cd = CentralDifference::new(&mut m, 0.0, v0, None);
+    for _ in 0..150 {
+        cd.step(&mut m, dt, None);
+    }
+    let sources = [3, 4, 13];
+    let pairs: Vec<(u64, u64)> = sources.iter().map(|&s| (s as u64, 1000 + s as u64)).collect();
+    m.duplicate_nodes(&pairs).unwrap();
+    let copy = m.duplicate_element(6, 500, &[1003, 1004, 1013]).unwrap();
+    let t = m.blt3().unwrap();
+    let k = match m.topology().store(copy) {
+        Some(Store::Blt3(k)) => k,
+        other => panic!("the copy is stored as {other:?}"),
+    };
+    for p in 0..5 {
+        assert_eq!(t.stress(k, p), t.stress(6, p), "stress at point {p}");
+        assert_eq!(t.plastic_strain(k, p).to_bits(), t.plastic_strain(6, p).to_bits());
+    }
+    assert_eq!(t.shear(k), t.shear(6));
+    cd.state.copy_nodes(&sources).unwrap();
+    cd.follow_topology(&mut m, None).unwrap();
+    for _ in 0..50 {
+        cd.step(&mut m, dt, None);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("structure.ckpt");
+    let mut ck = Checkpoint::new(200, cd.state.t);
+    save_state(&m, &mut ck).unwrap();
+    save_dynamics(&mut ck, &cd.state).unwrap();
+    ck.write_file(&path).unwrap();
+    for _ in 0..100 {
+        cd.step(&mut m, dt, None);
+    }
+    let ck = Checkpoint::read_file(&path).unwrap();
+    let mut r = triangle_plate(&base);
+    restore_state(&mut r, &ck).unwrap();
+    let mut cr = CentralDifference::resume(&r, load_dynamics(&ck, r.n_dof()).unwrap());
+    for _ in 0..100 {
+        cr.step(&mut r, dt, None);
+    }
+    assert!(triangle_bits(&r) == triangle_bits(&m), "restarted model state differs");
+    assert!(dynamics_bits(&cr.state) == dynamics_bits(&cd.state), "restarted motion differs");
+}

@@ -174,8 +174,6 @@ pub enum TopologyError {
     Reference { element: u64, node: u64, got: [f64; 3], expected: [f64; 3] },
     #[error("node {node}: {field} is not finite")]
     NotFinite { node: u64, field: &'static str },
-    #[error("element {element}: copying a 3-node explicit shell (BLT3) is not supported yet")]
-    Unsupported { element: u64 },
     #[error("topology record: {0}")]
     Record(String),
 }

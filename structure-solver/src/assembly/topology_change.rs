@@ -113,14 +113,11 @@ impl FeModel {
     }
 
     /// The element of cell `c` can be copied onto node slots `slots`: as many nodes, at its
-    /// nodes' reference positions, numbered within the BT4 connectivity's range.
+    /// nodes' reference positions, numbered within the explicit shells' connectivity range.
     pub(super) fn check_copy(&self, c: usize, slots: &[usize]) -> Result<(), TopologyError> {
         let id = |n: usize| self.topology.nodes.id(n).unwrap_or(n as u64);
         let element = self.topology.elements.id(c).unwrap_or(c as u64);
         let own = &self.cells[c];
-        if matches!(self.topology.store[c], Store::Blt3(_)) {
-            return Err(TopologyError::Unsupported { element });
-        }
         if slots.len() != own.len() {
             return Err(TopologyError::NodeCount {
                 element,
@@ -146,7 +143,7 @@ impl FeModel {
             }
             if u32::try_from(n).is_err() {
                 return Err(TopologyError::Record(format!(
-                    "node slot {n} is past the range of the BT4 connectivity"
+                    "node slot {n} is past the range of the explicit shells' connectivity"
                 )));
             }
         }
@@ -177,7 +174,13 @@ impl FeModel {
                 let k = b.push_copy(j, conn).expect("a BT4 cell's shell exists");
                 (Store::Bt4(k), true)
             }
-            Store::Blt3(_) => unreachable!("check_copy refuses BLT3 copies"),
+            Store::Blt3(j) => {
+                let b = self.explicit.as_mut().and_then(|e| e.triangles.as_mut());
+                let b = b.expect("a BLT3 cell has its part");
+                let conn = [0, 1, 2].map(|k| slots[k] as u32);
+                let k = b.push_copy(j, conn).expect("a BLT3 cell's shell exists");
+                (Store::Blt3(k), true)
+            }
         };
         let k = if rotations { 6 } else { 3 };
         for &n in &slots {

@@ -208,6 +208,28 @@ impl Blt3 {
         std::mem::swap(&mut self.committed, &mut self.trial);
     }
 
+    /// Appends a copy of element `e` on the nodes `conn` with its thickness, material and full
+    /// committed state (stress and plastic strain at every point, shear resultants), as the
+    /// phantom-node copies of a cracking shell need (thesis §3.5); the reference step bounds are
+    /// recomputed by the next [`Blt3::set_reference`]. Returns the copy's index, `None` if `e`
+    /// is not an element of the part.
+    pub fn push_copy(&mut self, e: usize, conn: [u32; 3]) -> Option<usize> {
+        if e >= self.conn.len() {
+            return None;
+        }
+        let np = self.settings.rule.len();
+        self.conn.push(conn);
+        self.thickness.push(self.thickness[e]);
+        self.material_of.push(self.material_of[e]);
+        let c = &mut self.committed;
+        c.stress.extend_from_within(e * np * N_STRESS..(e + 1) * np * N_STRESS);
+        c.alpha.extend_from_within(e * np..(e + 1) * np);
+        c.shear.extend_from_within(e * N_SHEAR..(e + 1) * N_SHEAR);
+        self.trial.clone_from(&self.committed);
+        self.work = forces::Work::default();
+        Some(self.conn.len() - 1)
+    }
+
     /// Committed stress `[σxx, σyy, σxy]` of element `e` at thickness point `p`, in the
     /// element frame.
     pub fn stress(&self, e: usize, p: usize) -> [f64; N_STRESS] {
