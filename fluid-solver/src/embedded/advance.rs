@@ -197,7 +197,10 @@ impl EmbeddedRun {
             for (i, p) in phi {
                 state.phi[i] = p;
             }
-            debug_assert!(ls.level_set.check(&State { material: material.to_vec(), ..state.clone() }).is_ok());
+            debug_assert!(ls
+                .level_set
+                .check(&State { material: material.to_vec(), ..state.clone() })
+                .is_ok());
         }
         if let Some(material) = changed_fluid {
             semi.set_materials(material.clone())?;

@@ -56,8 +56,10 @@ impl PhiWall {
     /// edges that changed ([`LsqGradient::remask`]), bitwise the one [`PhiWall::new`] builds.
     pub fn update(&mut self, mesh: &Mesh, tracker: &Tracker) {
         let through = through(mesh, tracker);
-        let flipped: Vec<u32> =
-            (0..mesh.n_edges()).filter(|&e| through[e] != self.through[e]).map(|e| e as u32).collect();
+        let flipped: Vec<u32> = (0..mesh.n_edges())
+            .filter(|&e| through[e] != self.through[e])
+            .map(|e| e as u32)
+            .collect();
         self.gradient.remask(mesh, &flipped, |i| tracker.adjacency.edges_of(i));
         self.through = through;
     }

@@ -200,8 +200,7 @@ impl LevelSet {
         through: Option<&[bool]>,
         step_number: u64,
     ) -> Result<(usize, bool), FluidError> {
-        let moved =
-            state.phi.iter().zip(&state.material).any(|(&p, &m)| self.material_of(p) != m);
+        let moved = state.phi.iter().zip(&state.material).any(|(&p, &m)| self.material_of(p) != m);
         if moved {
             // The interface normals of the ghost states: ∇φⁿ⁺¹.
             for (s, p) in lws.phi.iter_mut().zip(&state.phi) {
