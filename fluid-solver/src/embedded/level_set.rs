@@ -69,3 +69,48 @@ impl PhiWall {
         PhiAdvection { gradient: &self.gradient, open: &ls.open, through: Some(&self.through) }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bc::BoundaryCondition;
+    use crate::embedded::tests::{cube_mesh, plane};
+    use crate::embedded::tracker::Seed;
+    use crate::eos::Eos;
+    use crate::mesh::boxmesh::FACE_NAMES;
+    use crate::semidiscretization::{Numerics, Semidiscretization};
+    use interface_protocol::case::Tracking;
+
+    /// A plane through the slip walls moving across the mesh for several steps: the edges
+    /// updated from step to step are those built anew, none of them cut, and the operator is
+    /// bitwise the new one's.
+    #[test]
+    fn updated_phi_edges_equal_new_ones_bitwise() {
+        let walls: Vec<(String, BoundaryCondition)> =
+            FACE_NAMES.iter().map(|f| (f.to_string(), BoundaryCondition::SlipWall)).collect();
+        let eos = vec![Eos::PerfectGas { gamma: 1.4 }, Eos::PerfectGas { gamma: 1.67 }];
+        let mesh = cube_mesh(8, 0.25, 3);
+        let material = mesh.coords.iter().map(|x| u8::from(x[0] > 0.5)).collect();
+        let semi =
+            Semidiscretization::with_materials(mesh, eos, material, Numerics::default(), &walls)
+                .unwrap();
+        let ls = LevelSet::new(&semi, [0, 1], 5);
+        let mesh = &semi.mesh;
+        let rest = plane(-0.5, 1.5, -0.5, 1.5, 0.31);
+        let seeds = [Seed { point: [0.0; 3], fluid: true }];
+        let mut tracker = Tracker::new(mesh, rest.clone(), Tracking::Collision, &seeds).unwrap();
+        let mut wall = PhiWall::new(mesh, &ls, &tracker);
+        for k in 1..=5 {
+            let x: Vec<[f64; 3]> =
+                rest.x_b.iter().map(|p| [p[0], p[1], p[2] + 0.04 * k as f64]).collect();
+            let v = vec![[0.0, 0.0, 4.0]; x.len()];
+            tracker.advance(mesh, 0.01 * k as f64, &x, &v).unwrap();
+            wall.update(mesh, &tracker);
+            let fresh = PhiWall::new(mesh, &ls, &tracker);
+            assert_eq!(wall.through, fresh.through, "step {k}");
+            assert!(!tracker.cuts.cuts.is_empty());
+            assert!(tracker.cuts.cuts.iter().all(|c| !wall.through[c.edge as usize]));
+            assert_eq!(format!("{:?}", wall.gradient), format!("{:?}", fresh.gradient), "step {k}");
+        }
+    }
+}
