@@ -279,7 +279,7 @@ fn track(
         let timed = k > 0;
         let (tracking0, loads0) = (run.tracking_s, run.loads_s);
         let start = Instant::now();
-        let dt = run.step(&mut run_semi, &mut state, &mut ws, CFL, t, f64::INFINITY)?;
+        let dt = run.step(&mut run_semi, &mut state, &mut ws, CFL, t, f64::INFINITY, None)?;
         let step_seconds = start.elapsed().as_secs_f64();
         t += dt;
         if timed {

@@ -13,7 +13,8 @@
 //! array, the node materials and the level set plus `(step, t)`, and the time step and the
 //! reinitialisations depend only on them, on the target time and on the output times after `t`.
 
-use crate::embedded::{self, advance::EmbeddedRun};
+use crate::embedded::advance::{EmbeddedRun, LevelSetStep};
+use crate::embedded::{self};
 use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::output;
 use crate::probes::{Line, Placed};
@@ -337,10 +338,16 @@ impl<'a> FluidRun<'a> {
                     rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, stop - t)
                         .map_err(anyhow::Error::from)
                 }
-                (Some(e), _) => {
+                (Some(e), ls) => {
                     let (tracking, loads) = (e.tracking_s, e.loads_s);
                     let cfl = self.stepping.cfl();
-                    let r = e.step(&mut self.semi, &mut self.state, &mut self.ws, cfl, t, stop);
+                    let ls = ls.as_mut().map(|(level_set, lws)| LevelSetStep {
+                        level_set,
+                        lws,
+                        step_number: step + 1,
+                    });
+                    let (semi, state, ws) = (&mut self.semi, &mut self.state, &mut self.ws);
+                    let r = e.step(semi, state, ws, cfl, t, stop, ls);
                     let d = |s: f64| std::time::Duration::from_secs_f64(s.max(0.0));
                     self.timers.add(bucket::TRACKING, d(e.tracking_s - tracking));
                     self.timers.add(bucket::LOADS, d(e.loads_s - loads));

@@ -3,7 +3,9 @@
 //! -> the surface at `t_b` from its [`Kinematics`] -> tracking -> the nodes that changed side take
 //! their new side's fluid ([`super::side_fluid`]) and are filled -> the two RK2 stages with the
 //! walls -> `p*` and the nodal loads at `t_b` (Alg. 5.3 or 5.4), whose resultant force and moment
-//! go to `surface_forces.csv`.
+//! go to `surface_forces.csv`. With a level set ([`LevelSetStep`], [`super::level_set`]) the
+//! swept nodes also take a `φ` of their new side, `φ` advances with the two stages, and the nodes
+//! whose `φ` changed sign then change fluid, as in [`crate::levelset`].
 //!
 //! The surface moves the same way whoever prescribes it: a fluid-alone run samples its motion
 //! law at the end of every step; a coupled run samples the cubic Hermite path (DESIGN §4) between
@@ -13,12 +15,14 @@
 
 use super::case::{sample, Prescribed};
 use super::fill::fill_changed;
+use super::level_set::PhiWall;
 use super::loads::{nodal_loads, LoadView};
 use super::motion::RigidMotion;
-use super::side_fluid::side_materials;
+use super::side_fluid::{side_materials, side_phi};
 use super::step::{EmbeddedStep, Gradients, Wall};
 use super::surface::HermitePath;
 use super::tracker::Tracker;
+use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::mesh::geometry::{cross, norm};
 use crate::semidiscretization::Semidiscretization;
 use crate::state::{State, Workspace};
@@ -77,6 +81,16 @@ pub struct EmbeddedRun {
     forces: ProbeWriter,
     /// The last step's view of the boundary, updated from step to step.
     step: Option<EmbeddedStep>,
+    /// The edges of the last step's `φ` (with a level set).
+    phi_wall: Option<PhiWall>,
+}
+
+/// The level set of a step with the surface: its settings and scratch, and the number of this
+/// step from 1 (for the reinitialisation).
+pub struct LevelSetStep<'a> {
+    pub level_set: &'a LevelSet,
+    pub lws: &'a mut LevelSetWorkspace,
+    pub step_number: u64,
 }
 
 impl EmbeddedRun {
@@ -117,11 +131,13 @@ impl EmbeddedRun {
             loads_s: 0.0,
             forces,
             step: None,
+            phi_wall: None,
         })
     }
 
     /// One step from `t` at Courant number `cfl` that does not pass `stop` (a step that reaches
-    /// it ends on it exactly); returns the step taken.
+    /// it ends on it exactly), with the level set `level_set` if any; returns the step taken.
+    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
         semi: &mut Semidiscretization,
@@ -130,6 +146,7 @@ impl EmbeddedRun {
         cfl: f64,
         t: f64,
         stop: f64,
+        mut level_set: Option<LevelSetStep<'_>>,
     ) -> anyhow::Result<f64> {
         stable_time_step(semi, &state.cons, ws)?;
         let tracker = &self.tracker;
@@ -164,6 +181,27 @@ impl EmbeddedRun {
             &cut,
             semi.material(),
         );
+        if let Some(ls) = &level_set {
+            let material = changed_fluid.as_deref().unwrap_or(semi.material());
+            let adjacency = &tracker.adjacency;
+            let phi = side_phi(
+                &semi.mesh,
+                adjacency,
+                &changes,
+                sides,
+                &was_active,
+                &cut,
+                material,
+                &state.phi,
+            );
+            for (i, p) in phi {
+                state.phi[i] = p;
+            }
+            debug_assert!(ls
+                .level_set
+                .check(&State { material: material.to_vec(), ..state.clone() })
+                .is_ok());
+        }
         if let Some(material) = changed_fluid {
             semi.set_materials(material.clone())?;
             state.material = material;
@@ -187,17 +225,40 @@ impl EmbeddedRun {
             state.cons[i] = semi.eos_at(i).prim_to_cons(&w);
             ws.prim[i] = w;
         }
-        let semi = &*semi;
         // The view is updated in place (bitwise a new one); a failed step leaves none behind.
-        let step = match self.step.take() {
+        let mut step = match self.step.take() {
             Some(mut step) => {
                 step.update(semi, tracker);
                 step
             }
             None => EmbeddedStep::new(semi, tracker, self.p_cut, self.interface),
         };
+        let phi_wall = match (&level_set, self.phi_wall.take()) {
+            (None, _) => None,
+            (Some(_), Some(mut w)) => {
+                w.update(&semi.mesh, tracker);
+                Some(w)
+            }
+            (Some(ls), None) => Some(PhiWall::new(&semi.mesh, ls.level_set, tracker)),
+        };
         self.tracking_s += start.elapsed().as_secs_f64();
-        rk2_step_embedded(semi, state, ws, dt, &step, tracker)?;
+        let advection = match (&mut level_set, &phi_wall) {
+            (Some(ls), Some(w)) => Some((w.advection(ls.level_set), &mut *ls.lws)),
+            _ => None,
+        };
+        rk2_step_embedded(semi, state, ws, dt, &step, tracker, advection)?;
+        if let (Some(ls), Some(w)) = (level_set, &phi_wall) {
+            let LevelSetStep { level_set, lws, step_number } = ls;
+            let through = Some(&w.through[..]);
+            let (changed, _) =
+                level_set.after_flow(semi, state, lws, &w.gradient, through, step_number)?;
+            if changed > 0 {
+                // The special edges and the flow's gradient mask follow the new materials.
+                step = EmbeddedStep::new(semi, tracker, self.p_cut, self.interface);
+            }
+        }
+        self.phi_wall = phi_wall;
+        let semi = &*semi;
         let start = std::time::Instant::now();
         semi.primitives(&state.cons, ws)?;
         if step.interface == InterfaceTreatment::SecondOrder {

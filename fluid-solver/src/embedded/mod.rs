@@ -15,6 +15,7 @@ pub mod case;
 pub mod fill;
 pub mod generate;
 pub mod intersect;
+pub mod level_set;
 pub mod loads;
 pub mod motion;
 pub mod predicates;

@@ -14,6 +14,51 @@ use super::status::{NodeSides, NodeStatus, SideChange};
 use crate::mesh::Mesh;
 use crate::state::MaterialId;
 
+/// The nodes that changed side in a step and are active now, and the sources of each: its
+/// neighbours through an edge the surface does not cut now, on the same side, active before and
+/// after the step and not changed in it (module docs).
+struct Swept<'a> {
+    mesh: &'a Mesh,
+    adjacency: &'a NodeEdges,
+    changes: &'a [SideChange],
+    sides: &'a NodeSides,
+    was_active: &'a [bool],
+    cut: &'a [bool],
+    changed: std::collections::HashSet<u32>,
+}
+
+impl<'a> Swept<'a> {
+    fn new(
+        mesh: &'a Mesh,
+        adjacency: &'a NodeEdges,
+        changes: &'a [SideChange],
+        sides: &'a NodeSides,
+        was_active: &'a [bool],
+        cut: &'a [bool],
+    ) -> Swept<'a> {
+        let changed = changes.iter().map(|c| c.node).collect();
+        Swept { mesh, adjacency, changes, sides, was_active, cut, changed }
+    }
+
+    /// The swept nodes that are active now.
+    fn nodes(&self) -> impl Iterator<Item = usize> + '_ {
+        self.changes.iter().filter(|c| c.new_status == NodeStatus::Active).map(|c| c.node as usize)
+    }
+
+    /// The sources of node `i`.
+    fn sources(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        let sides = self.sides;
+        self.adjacency.neighbours(self.mesh, i).filter_map(move |(j, e)| {
+            let source = self.was_active[j]
+                && !self.changed.contains(&(j as u32))
+                && sides.status[j] == NodeStatus::Active
+                && sides.side[j] == sides.side[i]
+                && !self.cut[e as usize];
+            source.then_some(j)
+        })
+    }
+}
+
 /// The material layout after the changes of a step, or `None` when no node changes fluid.
 /// `was_active` is each node's status before the step, `cut` the new per-edge cut mask.
 pub fn side_materials(
@@ -25,20 +70,12 @@ pub fn side_materials(
     cut: &[bool],
     material: &[MaterialId],
 ) -> Option<Vec<MaterialId>> {
-    let changed: std::collections::HashSet<u32> = changes.iter().map(|c| c.node).collect();
+    let swept = Swept::new(mesh, adjacency, changes, sides, was_active, cut);
     let mut out: Option<Vec<MaterialId>> = None;
-    for c in changes.iter().filter(|c| c.new_status == NodeStatus::Active) {
-        let i = c.node as usize;
+    for i in swept.nodes() {
         let mut count = [0u32; 256];
-        for (j, e) in adjacency.neighbours(mesh, i) {
-            let source = was_active[j]
-                && !changed.contains(&(j as u32))
-                && sides.status[j] == NodeStatus::Active
-                && sides.side[j] == sides.side[i]
-                && !cut[e as usize];
-            if source {
-                count[material[j] as usize] += 1;
-            }
+        for j in swept.sources(i) {
+            count[material[j] as usize] += 1;
         }
         // The most common material of the sources, the lower id on a tie.
         let (best, n) = count
@@ -50,6 +87,33 @@ pub fn side_materials(
         }
     }
     out
+}
+
+/// The level set of the swept nodes that are active now (with a level set and a surface
+/// together): the mean `φ` of their sources that hold their new material `material[i]` (from
+/// [`side_materials`]), so the sign of `φ` gives that material; a node with no such source keeps
+/// its `φ` (and, having no source at all, its material). `(node, φ)`, ascending by change.
+pub fn side_phi(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    changes: &[SideChange],
+    sides: &NodeSides,
+    was_active: &[bool],
+    cut: &[bool],
+    material: &[MaterialId],
+    phi: &[f64],
+) -> Vec<(usize, f64)> {
+    let swept = Swept::new(mesh, adjacency, changes, sides, was_active, cut);
+    swept
+        .nodes()
+        .filter_map(|i| {
+            let (sum, n) = swept
+                .sources(i)
+                .filter(|&j| material[j] == material[i])
+                .fold((0.0, 0usize), |(s, n), j| (s + phi[j], n + 1));
+            (n > 0).then(|| (i, sum / n as f64))
+        })
+        .collect()
 }
 
 #[cfg(test)]

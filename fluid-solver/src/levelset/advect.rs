@@ -19,6 +19,10 @@
 //! and its MUSCL slopes alone would update it from its downstream neighbours (a downwind scheme,
 //! unstable); first order holds it at its value there. Symmetry planes and walls keep MUSCL
 //! (their mirror-symmetric gradients, [`super::gradient`]).
+//!
+//! With an embedded surface the edges it cuts, and those with an end that is not an active fluid
+//! node, carry nothing (`through`): their dual facet lies on the wall, where `φ_b = φ_i` as at
+//! any wall, so the level set is never taken across the structure.
 
 use super::LevelSetWorkspace;
 use crate::mesh::geometry::{dot, sub};
@@ -30,12 +34,15 @@ use crate::reconstruct::muscl::extrapolate;
 /// `R^φ` of `lws.phi` with the velocities of `prim` into `lws.residual` (module docs), calling
 /// `update(i, R^φ_i, &mut out[i])` for every node as soon as its residual is complete (within the
 /// same deterministic pass over the edge blocks, bitwise independent of the thread count). Nodes
-/// with `open[i]` (on far-field, inflow or outflow boundaries) extrapolate first order.
+/// with `open[i]` (on far-field, inflow or outflow boundaries) extrapolate first order; only the
+/// edges `e` with `through[e]` carry a flux (`None`: every edge).
+#[allow(clippy::too_many_arguments)]
 pub fn residual_and_update(
     mesh: &Mesh,
     gradient: &LsqGradient,
     limiter: Limiter,
     open: &[bool],
+    through: Option<&[bool]>,
     prim: &[[f64; 5]],
     lws: &mut LevelSetWorkspace,
     out: &mut [f64],
@@ -53,6 +60,9 @@ pub fn residual_and_update(
             r[i] = 0.0;
         }
         for e in blocks.edges(b) {
+            if through.is_some_and(|t| !t[e]) {
+                continue;
+            }
             let [i, j] = mesh.edges[e];
             let (i, j) = (i as usize, j as usize);
             let n = mesh.edge_normals[e];
@@ -138,6 +148,7 @@ mod tests {
                 &gradient,
                 limiter,
                 &open,
+                None,
                 &prim,
                 &mut lws,
                 &mut stage,
@@ -152,6 +163,7 @@ mod tests {
                 &gradient,
                 limiter,
                 &open,
+                None,
                 &prim,
                 &mut lws,
                 &mut next,

@@ -20,13 +20,15 @@ use crate::state::State;
 
 /// Sets `state.material` to the side of `state.phi` and gives every node whose material changed
 /// its ghost state (module docs), with `semi` still holding the layout of `t^n` and `grad_phi`
-/// the gradient of `state.phi`; returns the number of changed nodes. On error `state` is
-/// unchanged.
+/// the gradient of `state.phi`; the neighbours are those through the edges `e` with `through[e]`
+/// (`None`: all; with an embedded surface, never across it). Returns the number of changed
+/// nodes. On error `state` is unchanged.
 pub fn update_materials(
     semi: &Semidiscretization,
     ls: &LevelSet,
     grad_phi: &[[[f64; 3]; 1]],
     state: &mut State,
+    through: Option<&[bool]>,
 ) -> Result<usize, FluidError> {
     let mesh = &semi.mesh;
     let old = &state.material;
@@ -41,8 +43,8 @@ pub fn update_materials(
         let mut wb = [0.0; 5];
         let mut towards = [0.0; 3];
         let mut count = 0usize;
-        for (j, _) in ls.adjacency.neighbours(mesh, i) {
-            if old[j] == b {
+        for (j, e) in ls.adjacency.neighbours(mesh, i) {
+            if old[j] == b && through.is_none_or(|t| t[e as usize]) {
                 let wj = eos_b.cons_to_prim(&state.cons[j]);
                 for k in 0..5 {
                     wb[k] += wj[k];
@@ -148,7 +150,7 @@ mod tests {
         let semi = tube(10);
         let (water, air) = ([1000.0, 30.0, 0.0, 0.0, 2e5], [1.2, 30.0, 0.0, 0.0, 2e5]);
         let (ls, mut state) = moved(&semi, water, air);
-        let changed = update_materials(&semi, &ls, &along_x(&semi), &mut state).unwrap();
+        let changed = update_materials(&semi, &ls, &along_x(&semi), &mut state, None).unwrap();
         let at_half = semi.mesh.coords.iter().filter(|x| (x[0] - 0.5).abs() < 1e-12).count();
         assert_eq!(changed, at_half);
         for (i, x) in semi.mesh.coords.iter().enumerate() {
@@ -176,7 +178,7 @@ mod tests {
             State1d { rho: 50.0, u: 0.0, p: 1e5 },
         )
         .unwrap();
-        update_materials(&semi, &ls, &along_x(&semi), &mut state).unwrap();
+        update_materials(&semi, &ls, &along_x(&semi), &mut state, None).unwrap();
         let node = (0..semi.mesh.n_nodes())
             .find(|&i| (semi.mesh.coords[i][0] - 0.5).abs() < 1e-12)
             .unwrap();

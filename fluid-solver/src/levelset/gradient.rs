@@ -3,8 +3,8 @@
 //! the mirror planes of the flow's operator at symmetry planes and plane slip walls (`φ` is a
 //! scalar, even under the reflection). The flow's own gradients stay same-fluid: their operator
 //! masks the two-material edges ([`crate::semidiscretization::Semidiscretization::set_materials`]).
-//! Edges cut by an embedded surface would be masked here too; the level set does not run with an
-//! embedded surface yet (the case refuses the combination).
+//! With an embedded surface the edges it cuts, and those with an end that is not active, are
+//! masked out too ([`crate::embedded::level_set::PhiWall`]).
 
 use crate::reconstruct::gradient::LsqGradient;
 use crate::semidiscretization::Semidiscretization;

@@ -63,7 +63,7 @@ pub fn signed_distance(
             Seed { ends: [i, j], point, normal: None }
         })
         .collect();
-    let d = distance_to_interface(mesh, &ls.adjacency, &seeds);
+    let d = distance_to_interface(mesh, &ls.adjacency, &seeds, None);
     d.iter()
         .zip(material)
         .map(|(&d, &m)| {

@@ -13,6 +13,10 @@
 //!    sign-changing edges frozen ([`reinit`]), so reinitialisation never moves the interface and
 //!    never changes a material.
 //!
+//! With an embedded surface the step is the surface's ([`crate::embedded::advance`]): the same
+//! RK2 stages carry `φ`, and steps 2 and 3 ([`LevelSet::after_flow`]) never look across the
+//! structure ([`crate::embedded::level_set`]).
+//!
 //! Form: `φ_t + u·∇φ = 0` (Eq. 3.8), not the conservative `(ρφ)_t + ∇·(ρφu) = 0`. The ghost-fluid
 //! method carries two different fluxes on each interface edge and lets the density jump by three
 //! orders of magnitude there, so a mass flux of `ρφ` is neither single-valued at the interface nor
@@ -175,28 +179,48 @@ impl LevelSet {
     ) -> Result<InterfaceStep, FluidError> {
         let mut next = state.clone();
         let dt = rk2_step_level_set(semi, self, &mut next, ws, lws, stepping, dt_max)?;
-        let moved = next.phi.iter().zip(&next.material).any(|(&p, &m)| self.material_of(p) != m);
+        let (changed, reinitialised) =
+            self.after_flow(semi, &mut next, lws, &self.gradient, None, step_number)?;
+        *state = next;
+        Ok(InterfaceStep { dt, changed, reinitialised })
+    }
+
+    /// Steps 2 and 3 of the module docs once `state` holds the flow and `φ` at `t^{n+1}`: the
+    /// new materials and ghost states, the operator's layout, and the reinitialisation when
+    /// `step_number` is a multiple of `reinit_every`; `gradient` is the operator of `∇φ` and
+    /// `through` the edges `φ` is taken through (`None`: all; with an embedded surface, the
+    /// uncut edges between active nodes). Returns the number of nodes whose material changed and
+    /// whether `φ` was reinitialised.
+    pub fn after_flow(
+        &self,
+        semi: &mut Semidiscretization,
+        state: &mut State,
+        lws: &mut LevelSetWorkspace,
+        gradient: &LsqGradient,
+        through: Option<&[bool]>,
+        step_number: u64,
+    ) -> Result<(usize, bool), FluidError> {
+        let moved = state.phi.iter().zip(&state.material).any(|(&p, &m)| self.material_of(p) != m);
         if moved {
             // The interface normals of the ghost states: ∇φⁿ⁺¹.
-            for (s, p) in lws.phi.iter_mut().zip(&next.phi) {
+            for (s, p) in lws.phi.iter_mut().zip(&state.phi) {
                 s[0] = *p;
             }
-            self.gradient.compute(&semi.mesh, &lws.phi, &mut lws.grad);
+            gradient.compute(&semi.mesh, &lws.phi, &mut lws.grad);
         }
-        let changed = ghost::update_materials(semi, self, &lws.grad, &mut next)?;
+        let changed = ghost::update_materials(semi, self, &lws.grad, state, through)?;
         if changed > 0 {
-            semi.set_materials(next.material.clone())
+            semi.set_materials(state.material.clone())
                 .map_err(|e| FluidError::LevelSet(e.to_string()))?;
         }
         let reinitialised = self.reinit_every > 0 && step_number % self.reinit_every == 0;
         if reinitialised {
-            for (s, p) in lws.phi.iter_mut().zip(&next.phi) {
+            for (s, p) in lws.phi.iter_mut().zip(&state.phi) {
                 s[0] = *p;
             }
-            self.gradient.compute(&semi.mesh, &lws.phi, &mut lws.grad);
-            reinit::reinitialise(&semi.mesh, &self.adjacency, &lws.grad, &mut next.phi);
+            gradient.compute(&semi.mesh, &lws.phi, &mut lws.grad);
+            reinit::reinitialise(&semi.mesh, &self.adjacency, &lws.grad, &mut state.phi, through);
         }
-        *state = next;
-        Ok(InterfaceStep { dt, changed, reinitialised })
+        Ok((changed, reinitialised))
     }
 }

@@ -16,6 +16,12 @@
 //! reachable from the interface gets `φ = sign(φ_old) d`; a node with no interface in its
 //! connected part of the mesh keeps its `φ`. One sequential pass with a binary heap,
 //! `O(N log N)`, deterministic.
+//!
+//! With an embedded surface only the edges `through` it may cross (uncut, both ends active fluid
+//! nodes) hold interface points and carry the front: a sign change across the structure (water
+//! on one side of a shell, air on the other) is no interface of `φ`, the distance never passes
+//! through the structure, and the nodes that are not active, which the front never reaches, keep
+//! their `φ`.
 
 use super::LevelSet;
 use crate::embedded::adjacency::NodeEdges;
@@ -56,8 +62,14 @@ pub struct Seed {
 }
 
 /// Each node's distance to the interface through the points `seeds`, by the closest-point
-/// transform of the module docs; `∞` where no seed reaches.
-pub fn distance_to_interface(mesh: &Mesh, adjacency: &NodeEdges, seeds: &[Seed]) -> Vec<f64> {
+/// transform of the module docs over the edges `e` with `through[e]` (`None`: all); `∞` where no
+/// seed reaches.
+pub fn distance_to_interface(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    seeds: &[Seed],
+    through: Option<&[bool]>,
+) -> Vec<f64> {
     let n = mesh.n_nodes();
     let mut d2 = vec![f64::INFINITY; n];
     let mut closest = vec![u32::MAX; n];
@@ -81,8 +93,8 @@ pub fn distance_to_interface(mesh: &Mesh, adjacency: &NodeEdges, seeds: &[Seed])
         }
         done[i] = true;
         let c = seeds[closest[i] as usize].point;
-        for (k, _) in adjacency.neighbours(mesh, i) {
-            if done[k] {
+        for (k, e) in adjacency.neighbours(mesh, i) {
+            if done[k] || through.is_some_and(|t| !t[e as usize]) {
                 continue;
             }
             let r = sub(mesh.coords[k], c);
@@ -105,12 +117,20 @@ pub fn distance_to_interface(mesh: &Mesh, adjacency: &NodeEdges, seeds: &[Seed])
         .collect()
 }
 
-/// The zero of the linear interpolation of `φ` on every sign-changing edge, with its ends and the
-/// normal `∇φ/|∇φ|` interpolated from the ends' gradients `grad` (none where that vanishes).
-pub fn crossings(mesh: &Mesh, phi: &[f64], grad: &[[[f64; 3]; 1]]) -> Vec<Seed> {
+/// The zero of the linear interpolation of `φ` on every sign-changing edge `e` with `through[e]`
+/// (`None`: all), with its ends and the normal `∇φ/|∇φ|` interpolated from the ends' gradients
+/// `grad` (none where that vanishes).
+pub fn crossings(
+    mesh: &Mesh,
+    phi: &[f64],
+    grad: &[[[f64; 3]; 1]],
+    through: Option<&[bool]>,
+) -> Vec<Seed> {
     mesh.edges
         .iter()
-        .filter_map(|&[i, j]| {
+        .enumerate()
+        .filter(|(e, _)| through.is_none_or(|t| t[*e]))
+        .filter_map(|(_, &[i, j])| {
             let (i, j) = (i as usize, j as usize);
             let (a, b) = (phi[i], phi[j]);
             (LevelSet::side(a) != LevelSet::side(b)).then(|| {
@@ -125,21 +145,23 @@ pub fn crossings(mesh: &Mesh, phi: &[f64], grad: &[[[f64; 3]; 1]]) -> Vec<Seed> 
 }
 
 /// Resets `φ` to a signed distance with the ends of its sign-changing edges frozen (module
-/// docs), `grad` holding `∇φ`; returns the number of frozen nodes.
+/// docs), `grad` holding `∇φ`, over the edges `through` (`None`: all); returns the number of
+/// frozen nodes.
 pub fn reinitialise(
     mesh: &Mesh,
     adjacency: &NodeEdges,
     grad: &[[[f64; 3]; 1]],
     phi: &mut [f64],
+    through: Option<&[bool]>,
 ) -> usize {
-    let seeds = crossings(mesh, phi, grad);
+    let seeds = crossings(mesh, phi, grad, through);
     let mut frozen = vec![false; phi.len()];
     for seed in &seeds {
         for &i in &seed.ends {
             frozen[i] = true;
         }
     }
-    let d = distance_to_interface(mesh, adjacency, &seeds);
+    let d = distance_to_interface(mesh, adjacency, &seeds, through);
     for (i, p) in phi.iter_mut().enumerate() {
         // A node at zero distance would lose its sign (`-0 >= 0`): keep it.
         if !frozen[i] && d[i].is_finite() && d[i] > 0.0 {
@@ -186,11 +208,11 @@ mod tests {
             mesh.coords.iter().map(|&x| (r(x) - radius) * (1.0 + 3.0 * dot(x, x))).collect();
         let before = phi.clone();
         let grad = gradient(&mesh, &phi);
-        let frozen = reinitialise(&mesh, &adjacency, &grad, &mut phi);
+        let frozen = reinitialise(&mesh, &adjacency, &grad, &mut phi, None);
         assert!(frozen > 100, "{frozen} frozen nodes");
         let h = 1.0 / 16.0;
         let (mut near, mut far): (f64, f64) = (0.0, 0.0);
-        let seeds = crossings(&mesh, &before, &grad);
+        let seeds = crossings(&mesh, &before, &grad, None);
         let is_frozen = |i: usize| seeds.iter().any(|s| s.ends.contains(&i));
         for i in 0..mesh.n_nodes() {
             assert_eq!(LevelSet::side(phi[i]), LevelSet::side(before[i]), "node {i} changed side");
@@ -216,7 +238,7 @@ mod tests {
         // Again: the same frozen nodes, untouched.
         let mut again = phi.clone();
         let grad = gradient(&mesh, &phi);
-        reinitialise(&mesh, &adjacency, &grad, &mut again);
+        reinitialise(&mesh, &adjacency, &grad, &mut again, None);
         for i in 0..mesh.n_nodes() {
             assert_eq!(LevelSet::side(again[i]), LevelSet::side(before[i]));
             if is_frozen(i) {
@@ -235,7 +257,7 @@ mod tests {
         let x0 = 0.4071;
         let mut phi: Vec<f64> = mesh.coords.iter().map(|x| 3.0 * (x[0] - x0)).collect();
         let grad = gradient(&mesh, &phi);
-        reinitialise(&mesh, &adjacency, &grad, &mut phi);
+        reinitialise(&mesh, &adjacency, &grad, &mut phi, None);
         for (i, x) in mesh.coords.iter().enumerate() {
             if (x[0] - x0).abs() > 0.02 {
                 assert!((phi[i] - (x[0] - x0)).abs() < 1e-14, "node {i} at {x:?}: φ = {}", phi[i]);

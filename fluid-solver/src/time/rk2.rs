@@ -5,6 +5,7 @@ use super::cfl::{stable_time_step, TimeStepping};
 use crate::embedded::step::{EmbeddedStep, Wall};
 use crate::embedded::tracker::Tracker;
 use crate::levelset::{advect, LevelSet, LevelSetWorkspace};
+use crate::reconstruct::gradient::LsqGradient;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::state::{State, Workspace};
 
@@ -82,14 +83,64 @@ pub fn rk2_step_level_set(
     dt_max: f64,
 ) -> Result<f64, FluidError> {
     let steps = NodeSteps::new(semi, &state.cons, ws, stepping, dt_max)?;
+    let advection = PhiAdvection { gradient: &ls.gradient, open: &ls.open, through: None };
     let ratio = |i: usize| steps.ratio(semi, i);
+    let result = stages_with_phi(semi, state, ws, ratio, None, (advection, lws));
+    steps.finish(ws, result)
+}
+
+/// How `φ` is advected in a step ([`advect::residual_and_update`]): the operator of `∇φ`, the
+/// nodes on open boundaries, and the edges that carry its flux (`None`: all).
+#[derive(Clone, Copy)]
+pub struct PhiAdvection<'a> {
+    pub gradient: &'a LsqGradient,
+    pub open: &'a [bool],
+    pub through: Option<&'a [bool]>,
+}
+
+/// One RK2 step of exactly `dt` from `t_a = tracker.surface.t_a` to `t_b = t_a + dt` with the
+/// embedded boundary of `tracker` (cut edges at `t_b`, thesis §4.4): the first stage sees the
+/// wall velocity at `t_a`, the second at `t_b`; nodes that are not active keep their state.
+/// With `level_set`, `φ` advances by the same stages as in [`rk2_step_level_set`], through the
+/// edges of its [`PhiAdvection`] (never across the surface). `ws.prim` must hold the primitives
+/// of `state` (as [`stable_time_step`] leaves them). On error `state` is unchanged.
+pub fn rk2_step_embedded(
+    semi: &Semidiscretization,
+    state: &mut State,
+    ws: &mut Workspace,
+    dt: f64,
+    step: &EmbeddedStep,
+    tracker: &Tracker,
+    level_set: Option<(PhiAdvection<'_>, &mut LevelSetWorkspace)>,
+) -> Result<(), FluidError> {
+    let ratio = |i: usize| if tracker.active[i] { dt / semi.mesh.volumes[i] } else { 0.0 };
+    let (t_a, t_b) = (tracker.surface.t_a, tracker.surface.t_b);
+    let walls = [Wall { step, tracker, t: t_a }, Wall { step, tracker, t: t_b }];
+    match level_set {
+        Some(phi) => stages_with_phi(semi, state, ws, ratio, Some(walls), phi),
+        None => stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {}),
+    }
+}
+
+/// The two stages of the flow (with `walls`, if any) and of `φ` by `advection` with the
+/// velocities of each stage's flow state; `φ^{n+1}` is built in `lws.stage` and swapped into
+/// `state.phi` with the flow, so on error `state` is unchanged.
+fn stages_with_phi(
+    semi: &Semidiscretization,
+    state: &mut State,
+    ws: &mut Workspace,
+    ratio: impl Fn(usize) -> f64 + Sync,
+    walls: Option<[Wall<'_>; 2]>,
+    (advection, lws): (PhiAdvection<'_>, &mut LevelSetWorkspace),
+) -> Result<(), FluidError> {
     let mut phi_stage = std::mem::take(&mut lws.stage);
     let State { cons, phi, .. } = state;
     let phi_n = &phi[..];
     let limiter = semi.numerics.limiter;
     let mesh = &semi.mesh;
+    let ratio = &ratio;
     // `ws.prim` holds the primitives of the stage's flow state when each stage's flow pass ends.
-    let result = stages(semi, cons, ws, ratio, None, |stage, ws| {
+    let result = stages(semi, cons, ws, ratio, walls, |stage, ws| {
         // The stage's φ (φⁿ, then φ¹) into the advection workspace.
         let source: &[f64] = if stage == 0 { phi_n } else { &phi_stage };
         for (s, p) in lws.phi.iter_mut().zip(source) {
@@ -97,9 +148,10 @@ pub fn rk2_step_level_set(
         }
         advect::residual_and_update(
             mesh,
-            &ls.gradient,
+            advection.gradient,
             limiter,
-            &ls.open,
+            advection.open,
+            advection.through,
             &ws.prim,
             lws,
             &mut phi_stage,
@@ -115,25 +167,7 @@ pub fn rk2_step_level_set(
         std::mem::swap(phi, &mut phi_stage);
     }
     lws.stage = phi_stage;
-    steps.finish(ws, result)
-}
-
-/// One RK2 step of exactly `dt` from `t_a = tracker.surface.t_a` to `t_b = t_a + dt` with the
-/// embedded boundary of `tracker` (cut edges at `t_b`, thesis §4.4): the first stage sees the
-/// wall velocity at `t_a`, the second at `t_b`; nodes that are not active keep their state.
-/// `ws.prim` must hold the primitives of `state` (as [`stable_time_step`] leaves them).
-pub fn rk2_step_embedded(
-    semi: &Semidiscretization,
-    state: &mut State,
-    ws: &mut Workspace,
-    dt: f64,
-    step: &EmbeddedStep,
-    tracker: &Tracker,
-) -> Result<(), FluidError> {
-    let ratio = |i: usize| if tracker.active[i] { dt / semi.mesh.volumes[i] } else { 0.0 };
-    let (t_a, t_b) = (tracker.surface.t_a, tracker.surface.t_b);
-    let walls = [Wall { step, tracker, t: t_a }, Wall { step, tracker, t: t_b }];
-    stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {})
+    result
 }
 
 /// The two stages with `ratio(i) = Δt_i / |C_i|` (zero freezes a node), each with its wall; the

@@ -513,7 +513,7 @@ impl FluidSection {
             e.validate()?;
         }
         if let Some(l) = &self.level_set {
-            l.validate(&self.materials(), self.embedded.is_some())?;
+            l.validate(&self.materials())?;
         }
         let mut names: Vec<&str> = self.probes.iter().map(|p| p.name.as_str()).collect();
         names.sort_unstable();

@@ -36,12 +36,8 @@ impl Default for FluidLevelSet {
 }
 
 impl FluidLevelSet {
-    /// The level set needs exactly two fluids, and no embedded surface (not combined yet).
-    pub(crate) fn validate(
-        &self,
-        fluids: &[FluidMaterial<'_>],
-        embedded: bool,
-    ) -> Result<(), (String, String)> {
+    /// The level set needs exactly two fluids (an embedded surface may sit among them).
+    pub(crate) fn validate(&self, fluids: &[FluidMaterial<'_>]) -> Result<(), (String, String)> {
         if fluids.len() != 2 {
             let names: Vec<&str> = fluids.iter().map(|m| m.name).collect();
             return Err((
@@ -52,14 +48,6 @@ impl FluidLevelSet {
                     fluids.len(),
                     names.join(", ")
                 ),
-            ));
-        }
-        if embedded {
-            return Err((
-                "fluid.level_set".into(),
-                "a level set with an embedded surface ([fluid.embedded]) is not supported yet; \
-                 remove one of the two"
-                    .into(),
             ));
         }
         if self.reinit_every > MAX_REINIT_EVERY {
