@@ -12,6 +12,7 @@
 //! steps and the last one lands on the published state exactly.
 
 use super::case::{sample, Prescribed};
+use super::checkpoint::Undo;
 use super::fill::fill_changed;
 use super::loads::{nodal_loads, LoadView};
 use super::motion::RigidMotion;
@@ -121,7 +122,8 @@ impl EmbeddedRun {
     }
 
     /// One step from `t` at Courant number `cfl` that does not pass `stop` (a step that reaches
-    /// it ends on it exactly); returns the step taken.
+    /// it ends on it exactly); returns the step taken. A step that fails leaves the run, `state`
+    /// and the node materials as they were ([`super::checkpoint`]).
     pub fn step(
         &mut self,
         semi: &mut Semidiscretization,
@@ -130,6 +132,28 @@ impl EmbeddedRun {
         cfl: f64,
         t: f64,
         stop: f64,
+    ) -> anyhow::Result<f64> {
+        let saved = self.save();
+        let mut undo = Undo::default();
+        let result = self.try_step(semi, state, ws, cfl, t, stop, &mut undo);
+        if result.is_err() {
+            self.roll_back(saved, undo, semi, state, ws)
+                .map_err(|e| anyhow::anyhow!("the failed step could not be undone: {e:#}"))?;
+        }
+        result
+    }
+
+    /// [`EmbeddedRun::step`] recording in `undo` what it changes in the fluid state.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn try_step(
+        &mut self,
+        semi: &mut Semidiscretization,
+        state: &mut State,
+        ws: &mut Workspace,
+        cfl: f64,
+        t: f64,
+        stop: f64,
+        undo: &mut Undo,
     ) -> anyhow::Result<f64> {
         stable_time_step(semi, &state.cons, ws)?;
         let tracker = &self.tracker;
@@ -166,7 +190,7 @@ impl EmbeddedRun {
         );
         if let Some(material) = changed_fluid {
             semi.set_materials(material.clone())?;
-            state.material = material;
+            undo.material = Some(std::mem::replace(&mut state.material, material));
             // Nodes that changed fluid change the mask of uncut edges too: a new view.
             self.step = None;
         }
@@ -184,6 +208,7 @@ impl EmbeddedRun {
         )?;
         for (i, w) in filled {
             let i = i as usize;
+            undo.filled.push((i, state.cons[i]));
             state.cons[i] = semi.eos_at(i).prim_to_cons(&w);
             ws.prim[i] = w;
         }
@@ -198,6 +223,7 @@ impl EmbeddedRun {
         };
         self.tracking_s += start.elapsed().as_secs_f64();
         rk2_step_embedded(semi, state, ws, dt, &step, tracker)?;
+        undo.stepped = true;
         let start = std::time::Instant::now();
         semi.primitives(&state.cons, ws)?;
         if step.interface == InterfaceTreatment::SecondOrder {
@@ -273,6 +299,16 @@ impl EmbeddedRun {
             p_star: &tracker.p_star,
         };
         Ok(nodal_loads(self.load_algorithm, &view, out)?)
+    }
+
+    /// The step view of the last step (`None` before the first step, after a restore and after a
+    /// change of node materials: the next step builds it anew).
+    pub fn view(&self) -> Option<&EmbeddedStep> {
+        self.step.as_ref()
+    }
+
+    pub(super) fn clear_view(&mut self) {
+        self.step = None;
     }
 
     pub fn flush(&mut self) -> anyhow::Result<()> {
