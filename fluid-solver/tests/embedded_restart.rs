@@ -154,3 +154,28 @@ fn a_checkpoint_of_another_case_is_refused() {
     let e = refused("missing", &[]);
     assert!(e.contains("embedded.ckpt") && e.contains("[fluid.embedded]"), "{e}");
 }
+
+/// Water behind the receding face cavitates a few steps in: the run stops naming the state, and
+/// the checkpoint it keeps (fluid and embedded parts, the failed step rolled back) is byte for
+/// byte the one a run stopped just before that step writes.
+#[test]
+fn a_failed_step_keeps_the_last_good_embedded_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let water = [
+        "fluid.eos={kind=\"tait\",k1=2.07e9,k2=7.15,rho0=1000.0,p0=1e5}",
+        "fluid.initial.state=[1000.0,0.0,0.0,0.0,1e5]",
+        "fluid.boundary.xmin={kind=\"far_field\",state=[1000.0,0.0,0.0,0.0,1e5]}",
+    ];
+    let failed = dir.path().join("failed");
+    let e = run(&failed, &coarse(0.004, &water), None).unwrap_err().to_string();
+    println!("{e}");
+    assert!(e.contains("invalid fluid state"), "{e}");
+    let from = e.find("stopped at step ").unwrap() + "stopped at step ".len();
+    let step: u64 = e[from..].split(',').next().unwrap().parse().unwrap();
+    let stop = format!("fluid.time.max_steps={}", step - 1);
+    let mut before = water.to_vec();
+    before.push(&stop);
+    let good = dir.path().join("good");
+    assert_eq!(run(&good, &coarse(0.004, &before), None).unwrap().steps, step - 1);
+    assert_same_checkpoint(&good, &failed, step - 1);
+}

@@ -261,43 +261,7 @@ impl EmbeddedCheckpoint {
         let law = Kinematics::Law { motion: p.motion.clone(), reference: p.reference.clone() };
         self.decode(&p.tracker, &law, mesh)
     }
-}
 
-impl Decoded {
-    /// Puts `run` (set up from the case at `t = 0` on `mesh`) in the checkpoint's state.
-    pub fn restore(self, run: &mut EmbeddedRun, mesh: &Mesh) -> anyhow::Result<()> {
-        let Decoded { saved, kinematics, path, time } = self;
-        let fail = |m: String| anyhow::anyhow!("checkpoint `{}`: {m}", path.display());
-        let n_cuts = saved.p_star.len();
-        run.restore(saved, mesh).with_context(|| fail("its surface cannot be tracked".into()))?;
-        if let Some(k) = kinematics {
-            run.kinematics = k;
-        }
-        let t = &run.tracker;
-        if n_cuts != t.cuts.cuts.len() {
-            return Err(fail(format!(
-                "`p_star` holds {n_cuts} cut edges, but the surface at t = {time:e} cuts {} edges \
-                 of the case's mesh: the mesh or the surface changed since the checkpoint",
-                t.cuts.cuts.len()
-            )));
-        }
-        let occluded = |s: NodeStatus| s == NodeStatus::Occluded;
-        if let Some(i) =
-            (0..mesh.n_nodes()).find(|&i| occluded(t.sides.status[i]) != t.cuts.occluded[i])
-        {
-            return Err(fail(format!(
-                "node {i} (x = {:?}) is {:?} in `status`, but the surface at t = {time:e} {} \
-                 it: the mesh or the surface changed since the checkpoint",
-                mesh.coords[i],
-                t.sides.status[i],
-                if t.cuts.occluded[i] { "occludes" } else { "does not occlude" }
-            )));
-        }
-        Ok(())
-    }
-}
-
-impl EmbeddedCheckpoint {
     /// The saved state and a coupled run's kinematics, checked against the `tracker` and
     /// `kinematics` of the case (at `t = 0`) and `mesh`.
     pub fn decode(
@@ -442,5 +406,39 @@ impl EmbeddedCheckpoint {
             }
         }
         Ok(NodeSides { status, side: side.to_vec(), side_fluid })
+    }
+}
+
+impl Decoded {
+    /// Puts `run` (set up from the case at `t = 0` on `mesh`) in the checkpoint's state.
+    pub fn restore(self, run: &mut EmbeddedRun, mesh: &Mesh) -> anyhow::Result<()> {
+        let Decoded { saved, kinematics, path, time } = self;
+        let fail = |m: String| anyhow::anyhow!("checkpoint `{}`: {m}", path.display());
+        let n_cuts = saved.p_star.len();
+        run.restore(saved, mesh).with_context(|| fail("its surface cannot be tracked".into()))?;
+        if let Some(k) = kinematics {
+            run.kinematics = k;
+        }
+        let t = &run.tracker;
+        if n_cuts != t.cuts.cuts.len() {
+            return Err(fail(format!(
+                "`p_star` holds {n_cuts} cut edges, but the surface at t = {time:e} cuts {} edges \
+                 of the case's mesh: the mesh or the surface changed since the checkpoint",
+                t.cuts.cuts.len()
+            )));
+        }
+        let occluded = |s: NodeStatus| s == NodeStatus::Occluded;
+        if let Some(i) =
+            (0..mesh.n_nodes()).find(|&i| occluded(t.sides.status[i]) != t.cuts.occluded[i])
+        {
+            return Err(fail(format!(
+                "node {i} (x = {:?}) is {:?} in `status`, but the surface at t = {time:e} {} \
+                 it: the mesh or the surface changed since the checkpoint",
+                mesh.coords[i],
+                t.sides.status[i],
+                if t.cuts.occluded[i] { "occludes" } else { "does not occlude" }
+            )));
+        }
+        Ok(())
     }
 }
