@@ -10,8 +10,9 @@
 //! and the CFL step resumes after it.
 //!
 //! A restarted run is bitwise identical to an uninterrupted one: the state is the conserved
-//! array, the node materials and the level set plus `(step, t)`, and the time step and the
-//! reinitialisations depend only on them, on the target time and on the output times after `t`.
+//! array, the node materials and the level set plus `(step, t)` (and, with an embedded surface,
+//! the part of [`embedded::checkpoint`] beside it), and the time step and the reinitialisations
+//! depend only on them, on the target time and on the output times after `t`.
 
 use crate::embedded::advance::{EmbeddedRun, LevelSetStep};
 use crate::embedded::{self};
@@ -24,7 +25,7 @@ use crate::state::{State, Workspace};
 use crate::time::{reached, rk2_step, TimeStepping};
 use anyhow::Context;
 use interface_protocol::case::Case;
-use interface_protocol::io::checkpoint::{self, Checkpoint};
+use interface_protocol::io::checkpoint::{self, Checkpoint, Found};
 use interface_protocol::io::finite::{check_finite, Entity};
 use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::{write_line_sample, ProbeWriter};
@@ -63,7 +64,13 @@ pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State,
     let dir = run_dir.join("checkpoints");
     let found = checkpoint::latest(&dir, &[CHECKPOINT_PART])?
         .with_context(|| format!("no complete fluid checkpoint in {}", dir.display()))?;
-    let ck = Checkpoint::read(&dir, &found.tag, CHECKPOINT_PART)?;
+    read_fluid_part(&found, n_nodes)
+}
+
+/// The fluid part of the checkpoint `found` ([`read_checkpoint`]).
+fn read_fluid_part(found: &Found, n_nodes: usize) -> anyhow::Result<(State, u64, f64)> {
+    let part = format!("{CHECKPOINT_PART}.{}", checkpoint::EXTENSION);
+    let ck = Checkpoint::read_file(&found.dir.join(part))?;
     let cons = ck.f64_n::<5>("cons")?;
     let material = match ck.names().any(|n| n == "material") {
         true => ck.u8("material")?.to_vec(),
@@ -153,10 +160,22 @@ impl<'a> FluidRun<'a> {
             ..
         } = problem;
         let Placed { probe_nodes, mut lines } = placed;
-        // Read the checkpoint before the output folder is made: it may be the same folder.
-        let (state, step, t) = match &opts.restart {
-            Some(dir) => read_checkpoint(dir, semi.mesh.n_nodes())?,
-            None => (initial, 0, 0.0),
+        // Read the checkpoint before the output folder is made: it may be the same folder. A
+        // fluid-alone run with an embedded surface restarts from a checkpoint holding its state.
+        let n_nodes = semi.mesh.n_nodes();
+        let embedded_alone =
+            mode == Mode::Alone && case.fluid.as_ref().and_then(|f| f.embedded.as_ref()).is_some();
+        let (state, step, t, saved) = match &opts.restart {
+            Some(dir) if embedded_alone => {
+                let ck = embedded::checkpoint::latest(dir, CHECKPOINT_PART)?;
+                let (state, step, t) = read_fluid_part(&ck.found, n_nodes)?;
+                (state, step, t, Some(ck))
+            }
+            Some(dir) => {
+                let (state, step, t) = read_checkpoint(dir, n_nodes)?;
+                (state, step, t, None)
+            }
+            None => (initial, 0, 0.0, None),
         };
         if state.material != semi.material() {
             semi.set_materials(state.material.clone())
@@ -168,6 +187,16 @@ impl<'a> FluidRun<'a> {
             })?;
         }
         let level_set = level_set.map(|ls| (ls, LevelSetWorkspace::new(semi.mesh.n_nodes())));
+        // Coupled, the surface comes from the structure ([`crate::couple`] embeds it at `Init`).
+        // A restart sets the surface up at t = 0, as the run did, then restores its state.
+        let prescribed = match mode {
+            Mode::Alone => embedded::case::prescribed(case, &semi.mesh, 0.0)?,
+            Mode::Coupled => None,
+        };
+        let restored = match (&saved, &prescribed) {
+            (Some(ck), Some(p)) => Some(ck.check(p, &semi.mesh)?),
+            _ => None,
+        };
         let policy = match mode {
             Mode::Alone => Policy::alone(opts.force, opts.restart.as_deref(), &opts.out),
             Mode::Coupled => Policy::Existing,
@@ -181,19 +210,16 @@ impl<'a> FluidRun<'a> {
         }
         let mut ws = Workspace::new(semi.mesh.n_nodes());
         semi.primitives(&state.cons, &mut ws)?;
-        // Coupled, the surface comes from the structure ([`crate::couple`] embeds it at `Init`).
-        let prescribed = match mode {
-            Mode::Alone => embedded::case::prescribed(case, &semi.mesh, t)?,
-            Mode::Coupled => None,
-        };
         let embedded = match prescribed {
             None => None,
-            Some(_) if opts.restart.is_some() => anyhow::bail!(
-                "a run with [fluid.embedded] cannot restart yet: its node status is not in the checkpoints; run it from the start"
-            ),
             Some(p) => {
-                let p_cut = case.fluid.as_ref().and_then(|f| f.embedded.as_ref()).and_then(|e| e.p_cut);
-                Some(EmbeddedRun::new(p, p_cut, out.path())?)
+                let p_cut =
+                    case.fluid.as_ref().and_then(|f| f.embedded.as_ref()).and_then(|e| e.p_cut);
+                let mut e = EmbeddedRun::new(p, p_cut, out.path())?;
+                if let Some(r) = restored {
+                    r.restore(&mut e, &semi.mesh)?;
+                }
+                Some(e)
             }
         };
 
@@ -358,8 +384,9 @@ impl<'a> FluidRun<'a> {
             let dt = match result {
                 Ok(dt) => dt,
                 Err(e) => {
-                    // The state is unchanged by a failed step: keep it as the last good
-                    // checkpoint (coupled, the launcher names and asks for checkpoints).
+                    // The state is unchanged by a failed step (an embedded step rolls itself
+                    // back): keep it as the last good checkpoint (coupled, the launcher names and
+                    // asks for checkpoints).
                     if self.mode == Mode::Alone {
                         self.write_checkpoint(&checkpoint::tag_for_step(step))?;
                     }
@@ -427,9 +454,13 @@ impl<'a> FluidRun<'a> {
     }
 
     /// Writes the conserved state, node materials and level set as the checkpoint `tag` (part
-    /// [`CHECKPOINT_PART`]).
+    /// [`CHECKPOINT_PART`]), after the embedded surface's part if there is one (so a fluid part
+    /// always has its embedded part beside it).
     pub fn write_checkpoint(&mut self, tag: &str) -> anyhow::Result<()> {
         let start = Instant::now();
+        if let Some(e) = &self.embedded {
+            embedded::checkpoint::write(e, &self.out.checkpoints()?, tag, self.step, self.t)?;
+        }
         let mut ck = Checkpoint::new(self.step, self.t);
         ck.put_f64_n("cons", &self.state.cons)?;
         ck.put("material", self.state.material.clone())?;

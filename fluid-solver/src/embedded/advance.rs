@@ -14,6 +14,7 @@
 //! steps and the last one lands on the published state exactly.
 
 use super::case::{sample, Prescribed};
+use super::checkpoint::Undo;
 use super::fill::fill_changed;
 use super::level_set::PhiWall;
 use super::loads::{nodal_loads, LoadView};
@@ -136,7 +137,9 @@ impl EmbeddedRun {
     }
 
     /// One step from `t` at Courant number `cfl` that does not pass `stop` (a step that reaches
-    /// it ends on it exactly), with the level set `level_set` if any; returns the step taken.
+    /// it ends on it exactly), with the level set `level_set` if any; returns the step taken. A
+    /// step that fails leaves the run, `state` (level set included) and the node materials as
+    /// they were ([`super::checkpoint`]).
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
@@ -146,7 +149,36 @@ impl EmbeddedRun {
         cfl: f64,
         t: f64,
         stop: f64,
+        level_set: Option<LevelSetStep<'_>>,
+    ) -> anyhow::Result<f64> {
+        let saved = self.save();
+        let mut undo = Undo::default();
+        if level_set.is_some() {
+            // The level set and its materials change all over the step: keep them whole.
+            undo.material = Some(state.material.clone());
+            undo.phi = Some(state.phi.clone());
+        }
+        let result = self.try_step(semi, state, ws, cfl, t, stop, level_set, &mut undo);
+        if result.is_err() {
+            self.phi_wall = None;
+            self.roll_back(saved, undo, semi, state, ws)
+                .map_err(|e| anyhow::anyhow!("the failed step could not be undone: {e:#}"))?;
+        }
+        result
+    }
+
+    /// [`EmbeddedRun::step`] recording in `undo` what it changes in the fluid state.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn try_step(
+        &mut self,
+        semi: &mut Semidiscretization,
+        state: &mut State,
+        ws: &mut Workspace,
+        cfl: f64,
+        t: f64,
+        stop: f64,
         mut level_set: Option<LevelSetStep<'_>>,
+        undo: &mut Undo,
     ) -> anyhow::Result<f64> {
         stable_time_step(semi, &state.cons, ws)?;
         let tracker = &self.tracker;
@@ -204,7 +236,8 @@ impl EmbeddedRun {
         }
         if let Some(material) = changed_fluid {
             semi.set_materials(material.clone())?;
-            state.material = material;
+            let before = std::mem::replace(&mut state.material, material);
+            undo.material.get_or_insert(before);
             // Nodes that changed fluid change the mask of uncut edges too: a new view.
             self.step = None;
         }
@@ -222,6 +255,7 @@ impl EmbeddedRun {
         )?;
         for (i, w) in filled {
             let i = i as usize;
+            undo.filled.push((i, state.cons[i]));
             state.cons[i] = semi.eos_at(i).prim_to_cons(&w);
             ws.prim[i] = w;
         }
@@ -247,6 +281,7 @@ impl EmbeddedRun {
             _ => None,
         };
         rk2_step_embedded(semi, state, ws, dt, &step, tracker, advection)?;
+        undo.stepped = true;
         if let (Some(ls), Some(w)) = (level_set, &phi_wall) {
             let LevelSetStep { level_set, lws, step_number } = ls;
             let through = Some(&w.through[..]);
@@ -334,6 +369,16 @@ impl EmbeddedRun {
             p_star: &tracker.p_star,
         };
         Ok(nodal_loads(self.load_algorithm, &view, out)?)
+    }
+
+    /// The step view of the last step (`None` before the first step, after a restore and after a
+    /// change of node materials: the next step builds it anew).
+    pub fn view(&self) -> Option<&EmbeddedStep> {
+        self.step.as_ref()
+    }
+
+    pub(super) fn clear_view(&mut self) {
+        self.step = None;
     }
 
     pub fn flush(&mut self) -> anyhow::Result<()> {

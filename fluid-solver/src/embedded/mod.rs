@@ -6,12 +6,16 @@
 //! `predicates` (exact orientation tests) -> `intersect` (Alg. 4.1 and 4.2: the cut edges) ->
 //! `status` (active, occluded and inactive nodes, sides, swept nodes) -> `riemann_fs` (Alg. 5.1
 //! at every cut edge) -> `loads` (Alg. 5.3 and 5.4). The residual sees all of it through a
-//! read-only view with the stage time; `Semidiscretization` never owns the surface.
+//! read-only view with the stage time; `Semidiscretization` never owns the surface. What a run
+//! carries from step to step goes into its checkpoints ([`checkpoint`]).
 
 pub mod adjacency;
 pub mod advance;
 pub mod bvh;
 pub mod case;
+pub mod checkpoint;
+#[cfg(test)]
+mod checkpoint_tests;
 pub mod fill;
 pub mod generate;
 pub mod intersect;
