@@ -5,10 +5,9 @@
 //! sides' pressure disturbances are opposite. On the way the loads of the run's state are taken
 //! with both Alg. 5.3 and Alg. 5.4, each side's alone and both summed: each face's load on the
 //! plate's middle node column is the face pressure of the simple wave, and the two algorithms'
-//! resultants agree. The pressure on the cut plane `y = -0.025` is drawn
-//! to a PNG (set `HEAVING_PLATE_PNG=<path>` to choose where; the case folder's picture is the
-//! full case at t = 5 ms, drawn by `HEAVING_PLATE_PNG=cases/heaving-plate/pressure.png
-//! HEAVING_PLATE_END=5e-3`).
+//! resultants agree. The pressure on the cut plane `y = -0.025` is drawn to a PNG (set
+//! `HEAVING_PLATE_PNG=<path>` to choose where; the case folder's picture is the full case at
+//! t = 5 ms, drawn by `HEAVING_PLATE_PNG=cases/heaving-plate/pressure.png HEAVING_PLATE_END=5e-3`).
 
 use fluid_solver::embedded::loads::{nodal_loads, LoadAlgorithm, LoadView};
 use fluid_solver::eos::Eos;
