@@ -2,11 +2,14 @@
 //! tracking, Alg. 5.1 fluxes on both faces). Until the diffraction from the free edges reaches the
 //! probes on the plate's axis (about 1.5 ms), each face radiates the plane simple wave of a piston
 //! (`p' ≈ ±ρ c w`, `riemann::simple_wave`): the probes above and below follow it, and the two
-//! sides' pressure disturbances are opposite. The pressure on the cut plane `y = -0.025` is drawn
-//! to a PNG (set `HEAVING_PLATE_PNG=<path>` to choose where; the case folder's picture is the
-//! full case at t = 5 ms, drawn by `HEAVING_PLATE_PNG=cases/heaving-plate/pressure.png
-//! HEAVING_PLATE_END=5e-3`).
+//! sides' pressure disturbances are opposite. On the way the loads of the run's state are taken
+//! with both Alg. 5.3 and Alg. 5.4, each side's alone and both summed: each face's load on the
+//! plate's middle node column is the face pressure of the simple wave, and the two algorithms'
+//! resultants agree. The pressure on the cut plane `y = -0.025` is drawn to a PNG (set
+//! `HEAVING_PLATE_PNG=<path>` to choose where; the case folder's picture is the full case at
+//! t = 5 ms, drawn by `HEAVING_PLATE_PNG=cases/heaving-plate/pressure.png HEAVING_PLATE_END=5e-3`).
 
+use fluid_solver::embedded::loads::{nodal_loads, LoadAlgorithm, LoadView};
 use fluid_solver::eos::Eos;
 use fluid_solver::riemann::simple_wave::SimpleWave;
 use fluid_solver::solver::{self, FluidRun, Mode, RunOptions};
@@ -56,19 +59,103 @@ fn piston_pressure(z: f64, t: f64, below: bool) -> f64 {
     wave.state(s * z, t).expect("smooth before the shock").2
 }
 
-/// Runs the case to `t_end` into `out`: the node positions and primitive states at the end.
-fn run(t_end: f64, out: &Path) -> (Vec<[f64; 3]>, Vec<[f64; 5]>) {
+/// The pressure on the face of the plate on the side `below`: the simple wave's at the piston,
+/// `p0 (1 - (γ - 1) u / (2 c0))^(2γ / (γ - 1))` with `u` the face's speed away from the gas (the
+/// Riemann invariant `u + 2c / (γ - 1)` of the gas at rest).
+fn face_pressure(t: f64, below: bool) -> f64 {
+    let gamma = 1.4f64;
+    let c0 = (gamma * P0 / RHO0).sqrt();
+    let u = if below { plate(t).1 } else { -plate(t).1 };
+    P0 * (1.0 - 0.5 * (gamma - 1.0) * u / c0).powf(2.0 * gamma / (gamma - 1.0))
+}
+
+/// The slab's width in y (the mesh's), over which the plate is wet.
+const SLAB: f64 = 0.05;
+/// The plate's node spacing along x (1 m in 8 cells).
+const DX: f64 = 0.125;
+
+/// The loads of the run's current state by both algorithms (`[Alg. 5.3, Alg. 5.4]`).
+struct LoadSample {
+    t: f64,
+    /// `z` resultant of both sides summed.
+    fz: [f64; 2],
+    /// Per side (`[below, above]`), the pressure disturbance `p* - p0` its load puts on the middle
+    /// node column `x = 0`: `±f_z / (Δx · slab)` (the column's shape functions sum to the hat of
+    /// width `2 Δx` in x; the disturbance alone, since the distribution's O(h) error in the
+    /// column's share of the area would weigh on all of `p0`).
+    face: [[f64; 2]; 2],
+}
+
+fn sample_loads(run: &FluidRun) -> LoadSample {
+    let mesh = &run.semidiscretization().mesh;
+    let tracker = &run.embedded().expect("an embedded surface").tracker;
+    let surface = &tracker.surface;
+    let zp = plate(surface.t_b).0;
+    let column: Vec<usize> =
+        (0..surface.n_nodes()).filter(|&n| surface.x_b[n][0].abs() < 1e-9).collect();
+    assert_eq!(column.len(), 2, "the middle column of the plate's nodes");
+    let cuts = &tracker.cuts.cuts;
+    // `p* - p0` of one side only: an end is below the plate when its node is.
+    let one_side = |below: bool| -> Vec<[f64; 2]> {
+        let ps = tracker.p_star.iter().zip(cuts);
+        ps.map(|(p, c)| {
+            let ends = mesh.edges[c.edge as usize];
+            [0, 1].map(|m| {
+                let under = mesh.coords[ends[m] as usize][2] < zp;
+                if under == below {
+                    p[m] - P0
+                } else {
+                    f64::NAN
+                }
+            })
+        })
+        .collect()
+    };
+    let loads = |algorithm: LoadAlgorithm, p_star: &[[f64; 2]]| {
+        let view = LoadView {
+            mesh,
+            adjacency: &tracker.adjacency,
+            surface,
+            t: surface.t_b,
+            side: &tracker.sides.side,
+            cuts,
+            p_star,
+        };
+        let mut out = vec![[0.0; 3]; surface.n_nodes()];
+        nodal_loads(algorithm, &view, &mut out).unwrap();
+        out
+    };
+    let (below, above) = (one_side(true), one_side(false));
+    let algorithms = [LoadAlgorithm::Reconstructed, LoadAlgorithm::Facets];
+    let fz = algorithms.map(|a| loads(a, &tracker.p_star).iter().map(|f| f[2]).sum());
+    let face = algorithms.map(|a| {
+        [(&below, 1.0), (&above, -1.0)].map(|(p, sign)| {
+            let f = loads(a, p);
+            sign * column.iter().map(|&n| f[n][2]).sum::<f64>() / (DX * SLAB)
+        })
+    });
+    LoadSample { t: surface.t_b, fz, face }
+}
+
+/// Runs the case to `t_end` into `out`, taking the loads at the times `at` on the way: the node
+/// positions and primitive states at the end, and the load samples.
+fn run(t_end: f64, out: &Path, at: &[f64]) -> (Vec<[f64; 3]>, Vec<[f64; 5]>, Vec<LoadSample>) {
     let overrides = vec![format!("fluid.time.t_end={t_end:e}")];
     let case = Case::load(&case_path(), &overrides).unwrap();
     let text = std::fs::read_to_string(case_path()).unwrap();
     let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: false };
     let mut run = FluidRun::open(&case, &text, &opts, Mode::Alone).unwrap();
     let coords = run.semidiscretization().mesh.coords.clone();
+    let mut samples = Vec::new();
+    for &t in at.iter().filter(|&&t| t < t_end) {
+        run.advance_to(t).unwrap();
+        samples.push(sample_loads(&run));
+    }
     run.advance_to(run.t_end()).unwrap();
     let summary = run.finish().unwrap();
     let (state, _, _) = solver::read_checkpoint(out, summary.nodes).unwrap();
     let eos = Eos::PerfectGas { gamma: 1.4 };
-    (coords, state.cons.iter().map(|q| eos.cons_to_prim(q)).collect())
+    (coords, state.cons.iter().map(|q| eos.cons_to_prim(q)).collect(), samples)
 }
 
 /// A blue-white-red colour for `v` in `[-1, 1]`.
@@ -126,7 +213,9 @@ fn heaving_plate_radiates_piston_waves_of_opposite_sign() {
     let t_end: f64 =
         std::env::var("HEAVING_PLATE_END").map_or(1.4e-3, |s| s.parse().expect("a time in s"));
     let out = dir.path().join("run");
-    let (coords, prim) = run(t_end, &out);
+    // Before the free edges' diffraction reaches the middle column (|0.5 - Δx| / c ≈ 1.0 ms).
+    let at: Vec<f64> = (1..=8).map(|k| 1e-4 * k as f64).collect();
+    let (coords, prim, samples) = run(t_end, &out, &at);
     let probes = columns(&out.join("probes.csv"));
     let (t, above, below) = (&probes["time"], &probes["above.p"], &probes["below.p"]);
     let (z_above, z_below) = (0.1, -0.05);
@@ -156,6 +245,43 @@ fn heaving_plate_radiates_piston_waves_of_opposite_sign() {
     assert!(largest > 0.6 * peak, "the wave above the plate is too weak: {largest} Pa");
     assert!(worst[0] < 0.08 * peak && worst[1] < 0.08 * peak, "{worst:?} against {peak}");
     assert!(asymmetry < 0.08 * peak, "sides not opposite: {asymmetry} Pa");
+    // Each face's load is its face pressure, with either algorithm (within 8% of ρ c w_max), and
+    // the two algorithms' resultants agree.
+    let area = 1.0 * SLAB;
+    let mut face_error = [[0.0f64; 2]; 2];
+    let mut resultant_gap = 0.0f64;
+    for s in &samples {
+        let exact = [face_pressure(s.t, true) - P0, face_pressure(s.t, false) - P0];
+        for (a, err) in face_error.iter_mut().enumerate() {
+            for side in 0..2 {
+                err[side] = err[side].max((s.face[a][side] - exact[side]).abs());
+            }
+        }
+        resultant_gap = resultant_gap.max((s.fz[0] - s.fz[1]).abs());
+        println!(
+            "t {:.2} ms: face p' below {:.1} / {:.1} Pa (5.3 / 5.4; simple wave {:.1}), above \
+             {:.1} / {:.1} Pa (simple wave {:.1}); fz {:.2} / {:.2} N",
+            s.t * 1e3,
+            s.face[0][0],
+            s.face[1][0],
+            exact[0],
+            s.face[0][1],
+            s.face[1][1],
+            exact[1],
+            s.fz[0],
+            s.fz[1]
+        );
+    }
+    println!(
+        "face pressure against the simple wave: Alg. 5.3 {:.1?} Pa, Alg. 5.4 {:.1?} Pa; largest \
+         |fz(5.3) - fz(5.4)| {resultant_gap:.3} N (2 ρ c w_max A = {:.1} N)",
+        face_error[0],
+        face_error[1],
+        2.0 * peak * area
+    );
+    assert_eq!(samples.len(), at.len(), "load samples");
+    assert!(face_error.iter().flatten().all(|&e| e < 0.08 * peak), "{face_error:?} vs {peak}");
+    assert!(resultant_gap < 0.05 * 2.0 * peak * area, "resultants differ by {resultant_gap} N");
     // The load on the plate opposes its velocity while it accelerates upwards.
     let forces = columns(&out.join("surface_forces.csv"));
     let (tf, fz) = (&forces["time"], &forces["surface.fz"]);

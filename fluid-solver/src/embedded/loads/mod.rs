@@ -4,14 +4,16 @@
 //!
 //! - [`LoadAlgorithm::Reconstructed`], Alg. 5.3 (Eq. 5.18) with the reconstruction of Alg. 5.2:
 //!   inside every cut cell the polygon through the intersection points of its cut edges, each
-//!   triangle of it with its own normal, `p*` interpolated linearly, Gauss points distributed with
-//!   the shape functions of the structure triangle the point projects onto ([`reconstructed`]);
+//!   triangle of it with its own normal, `p*` interpolated linearly, each point's share of the
+//!   load distributed with the shape functions of the structure triangle at that point (on a
+//!   one-fluid shell every cut edge joins, its ends' sides by the orientation contract)
+//!   ([`reconstructed`]);
 //! - [`LoadAlgorithm::Facets`], Alg. 5.4 (Eq. 5.51): the surrogate interface of the dual facets of
 //!   the cut edges, `p*` times the full facet area vector `ν_ij` at the intersection point,
 //!   distributed with its barycentric coordinates ([`facets`]).
 //!
 //! Both conserve the resultant (partition of unity, Eq. 5.19, 5.52), and both give zero net force
-//! for a constant pressure on a closed surface. Output: one `[f64; 3]` per surface node in the
+//! for a constant pressure on a closed surface; Alg. 5.3 also zero moment. Output: one `[f64; 3]` per surface node in the
 //! surface's (the protocol's) node order, the loads of both sides of a shell summed. The force on
 //! the structure from the fluid at node `i` of a cut edge points from `i` towards the wall.
 

@@ -2,6 +2,15 @@
 //! the polygon through the intersection points of its cut edges (one point per cut edge, so the
 //! polygons of two cells sharing a face share its segment and the interface is watertight).
 //!
+//! Which cut edges join it ([`joining_cuts`]): those whose ends lie on different sides of the
+//! flood fill (an edge whose ends share a side there crosses the surface twice; one point cannot
+//! stand for it, and every cell around it leaves it out alike, which keeps the interface closed);
+//! and on a one-fluid shell (an open connected part of the surface whose cut edges reach a single
+//! fluid side: both its faces face one connected fluid, as a plate with free edges does) every cut
+//! edge, its ends' sides being those of the orientation contract (PROTOCOL.md: the `+` end is the
+//! one `n_E` points to, [`wall_normal_from_i`]). An edge crossing such a shell twice keeps its
+//! crossing nearest to its node `i`.
+//!
 //! Polygons are ordered by walking the cell's faces: a face with two cut edges gives the segment
 //! between their points; a face with four (an ambiguous quad face, its diagonal corners on the
 //! same side) pairs the two cut edges at its lowest-numbered node and the other two (one fixed
@@ -12,12 +21,18 @@
 //! about its centroid), each with its own normal.
 //!
 //! On each triangle the load density is `q n̂`, `q = p*_- - p*_+` interpolated linearly from the
-//! points (`+` the end of the cut edge on the side `n_E` points to), integrated with the
-//! 3-point degree-2 rule; each Gauss point's force goes to the structure triangle nearest to it
-//! (closest-point projection onto the triangles hit by the cell's cut edges) with that triangle's
-//! shape functions at the projection (Eq. 5.18). The resultant is `Σ ∫ q n̂` exactly (Eq. 5.19).
+//! points. Eq. 5.18: the force of vertex `I_k` is `F_k = ∫ q N̂_k n̂` (exact: the rows of the P1
+//! mass matrix), and it goes to the structure with the shape functions of the structure triangle
+//! hit by `I_k`'s cut edge at `I_k` (`N_i^q(ξ_k)`, the cut's barycentric coordinates). The fan's
+//! centre moves as the mean of the polygon's points, so its force goes to them in equal shares.
+//! Hence the resultant is `Σ ∫ q n̂` (Eq. 5.19), and the nodal moment `Σ x_i × f_i` is
+//! `Σ_k I_k × F_k`, which for a uniform pressure is `p ∫ x × n̂` over the reconstructed
+//! interface: zero on a closed one, to round-off.
 
 use super::{distribute, or_zero, LoadView};
+use crate::embedded::riemann_fs::wall_normal_from_i;
+use crate::embedded::status::NO_SIDE;
+use crate::embedded::Surface;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Cell;
 
@@ -29,17 +44,20 @@ struct Vertex {
     q: f64,
     /// Unit vector along the cut edge from its `-` end to its `+` end.
     across: [f64; 3],
+    /// Index of its cut edge.
+    cut: usize,
 }
 
 pub(super) fn loads(view: &LoadView, out: &mut [[f64; 3]]) {
-    gauss_loads(view, |_, f, tri, bary| distribute(view.surface, tri, bary, f, out));
+    vertex_loads(view, |_, f, tri, bary| distribute(view.surface, tri, bary, f, out));
 }
 
-/// Calls `sink(x, f, triangle, bary)` for every Gauss point `x` of the reconstructed interface
-/// with its force `f` on the structure and the structure triangle and barycentric coordinates of
-/// its projection. Only the cells around the cut edges are visited, in ascending order.
-pub(super) fn gauss_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3])) {
-    gauss_loads_in(view, &cut_cells(view), sink);
+/// Calls `sink(x, f, triangle, bary)` for every vertex contribution of the reconstructed
+/// interface: the intersection point `x`, its force `f` on the structure, and the structure
+/// triangle hit there with the barycentric coordinates of `x` in it. Only the cells around the
+/// cut edges are visited, in ascending order.
+pub(super) fn vertex_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3])) {
+    vertex_loads_in(view, &cut_cells(view), sink);
 }
 
 /// The cells holding both ends of some cut edge, ascending: every cell with a cut edge, so every
@@ -56,16 +74,17 @@ pub(super) fn cut_cells(view: &LoadView) -> Vec<u32> {
     cells
 }
 
-/// [`gauss_loads`] over the given `cells` (ascending), which must include every cut cell.
-pub(super) fn gauss_loads_in(
+/// [`vertex_loads`] over the given `cells` (ascending), which must include every cut cell.
+pub(super) fn vertex_loads_in(
     view: &LoadView,
     cells: &[u32],
     mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
+    let joining = joining_cuts(view);
     let mut polygon = Vec::with_capacity(12);
     for &k in cells {
         let cell = &view.mesh.cells[k as usize];
-        let cut_of = cell_cuts(view, cell);
+        let cut_of = cell_cuts(view, &joining, cell);
         if cut_of.iter().flatten().count() < 3 {
             continue;
         }
@@ -73,24 +92,95 @@ pub(super) fn gauss_loads_in(
             polygon.clear();
             polygon.extend(cycle.iter().map(|&k| vertex(view, k)));
             orient(&mut polygon, walked);
-            integrate(view, &cycle, &polygon, &mut sink);
+            integrate(view, &polygon, &mut sink);
         }
     }
 }
 
-/// For each local edge of `cell`, the index of its cut edge, if it is cut and its ends lie on
-/// different sides (an edge whose ends share a side crosses the surface twice; one point cannot
-/// stand for it, and every cell around it leaves it out alike, which keeps the interface closed).
-fn cell_cuts(view: &LoadView, cell: &Cell) -> [Option<usize>; 12] {
+/// Per cut edge, whether it joins the reconstruction (see the module docs): its ends on different
+/// sides, or its triangle on a one-fluid shell.
+fn joining_cuts(view: &LoadView) -> Vec<bool> {
+    let part = open_parts(view.surface);
+    // Per part: the first fluid side its cut edges reach, and whether they reach another.
+    let mut reached: Vec<(u32, bool)> = vec![(NO_SIDE, false); part.len()];
+    for c in view.cuts {
+        let Some(root) = part[c.triangle as usize] else { continue };
+        for n in view.mesh.edges[c.edge as usize] {
+            let side = view.side[n as usize];
+            let r = &mut reached[root as usize];
+            if side == NO_SIDE || side == r.0 {
+                continue;
+            }
+            if r.0 == NO_SIDE {
+                r.0 = side;
+            } else {
+                r.1 = true;
+            }
+        }
+    }
+    view.cuts
+        .iter()
+        .map(|c| {
+            let [i, j] = view.mesh.edges[c.edge as usize];
+            let one_fluid_shell = part[c.triangle as usize].is_some_and(|r| !reached[r as usize].1);
+            one_fluid_shell || view.side[i as usize] != view.side[j as usize]
+        })
+        .collect()
+}
+
+/// Per surface triangle, its connected part (triangles joined through shared edges, named by one
+/// of them) if that part is open (has an edge a single triangle holds), else `None`.
+fn open_parts(surface: &Surface) -> Vec<Option<u32>> {
+    let n = surface.triangles.len();
+    let mut edges: Vec<([u32; 2], u32)> = Vec::with_capacity(3 * n);
+    for (t, tri) in surface.triangles.iter().enumerate() {
+        for m in 0..3 {
+            let (a, b) = (tri[m], tri[(m + 1) % 3]);
+            edges.push(([a.min(b), a.max(b)], t as u32));
+        }
+    }
+    edges.sort_unstable();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let find = |parent: &mut Vec<u32>, mut a: u32| {
+        while parent[a as usize] != a {
+            parent[a as usize] = parent[parent[a as usize] as usize];
+            a = parent[a as usize];
+        }
+        a
+    };
+    let mut free = Vec::new();
+    for run in edges.chunk_by(|x, y| x.0 == y.0) {
+        if run.len() == 1 {
+            free.push(run[0].1);
+        }
+        for w in run.windows(2) {
+            let (a, b) = (find(&mut parent, w[0].1), find(&mut parent, w[1].1));
+            parent[a as usize] = b;
+        }
+    }
+    let mut open = vec![false; n];
+    for t in free {
+        let r = find(&mut parent, t);
+        open[r as usize] = true;
+    }
+    (0..n as u32)
+        .map(|t| {
+            let r = find(&mut parent, t);
+            open[r as usize].then_some(r)
+        })
+        .collect()
+}
+
+/// For each local edge of `cell`, the index of its cut edge, if it is cut and joins the
+/// reconstruction (`joining`, per cut edge).
+fn cell_cuts(view: &LoadView, joining: &[bool], cell: &Cell) -> [Option<usize>; 12] {
     let mut cut_of = [None; 12];
     for (l, &[a, b]) in cell.kind.edges().iter().enumerate() {
         let (p, q) = (cell.nodes[a], cell.nodes[b]);
-        if view.side[p as usize] == view.side[q as usize] {
-            continue;
-        }
         let key = [p.min(q), p.max(q)];
         if let Ok(e) = view.mesh.edges.binary_search(&key) {
-            cut_of[l] = view.cuts.binary_search_by_key(&(e as u32), |c| c.edge).ok();
+            let k = view.cuts.binary_search_by_key(&(e as u32), |c| c.edge).ok();
+            cut_of[l] = k.filter(|&k| joining[k]);
         }
     }
     cut_of
@@ -164,16 +254,18 @@ fn cycles(cell: &Cell, cut_of: &[Option<usize>; 12]) -> Vec<(Vec<usize>, bool)> 
     out
 }
 
-/// The polygon vertex of cut `k`: its intersection point and `q = p*_- - p*_+`.
+/// The polygon vertex of cut `k`: its intersection point and `q = p*_- - p*_+`, the `+` end the
+/// one `n_E` points to (the orientation contract).
 fn vertex(view: &LoadView, k: usize) -> Vertex {
     let cut = &view.cuts[k];
-    let [i, j] = view.mesh.edges[cut.edge as usize];
+    let e = cut.edge as usize;
+    let [i, j] = view.mesh.edges[e];
     let (xi, xj) = (view.mesh.coords[i as usize], view.mesh.coords[j as usize]);
     let d = sub(xj, xi);
     let [pi, pj] = view.p_star[k].map(or_zero);
-    // The `+` end is the one n_E points to.
-    let (q, s) = if dot(cut.normal, d) > 0.0 { (pi - pj, 1.0) } else { (pj - pi, -1.0) };
-    Vertex { x: add(xi, scale(d, cut.alpha)), q, across: scale(d, s / norm(d)) }
+    let towards_j = dot(wall_normal_from_i(cut.normal, d, view.mesh.edge_normals[e]), cut.normal);
+    let (q, s) = if towards_j > 0.0 { (pi - pj, 1.0) } else { (pj - pi, -1.0) };
+    Vertex { x: add(xi, scale(d, cut.alpha)), q, across: scale(d, s / norm(d)), cut: k }
 }
 
 /// Orders the vertices of a polygon that did not come from the face walk by angle about their
@@ -216,94 +308,43 @@ fn any_perpendicular(n: [f64; 3]) -> [f64; 3] {
     scale(p, 1.0 / norm(p))
 }
 
-/// Degree-2 rule on a triangle: barycentric points, weight 1/3 each.
-const GAUSS: [[f64; 3]; 3] = [
-    [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
-    [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
-    [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
-];
-
-/// Integrates `q n̂` over the triangles of an oriented polygon into `sink`.
+/// Integrates `q n̂` over the triangles of an oriented polygon into per-vertex forces (Eq. 5.18)
+/// and hands them to `sink` with their cuts' triangles and barycentric coordinates.
 fn integrate(
     view: &LoadView,
-    cycle: &[usize],
     poly: &[Vertex],
     sink: &mut impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
-    let mut candidates: Vec<u32> = cycle.iter().map(|&k| view.cuts[k].triangle).collect();
-    candidates.sort_unstable();
-    candidates.dedup();
-    let corners: Vec<[[f64; 3]; 3]> =
-        candidates.iter().map(|&t| view.surface.triangle_at(t as usize, view.t).0).collect();
-    let mut triangle = |a: ([f64; 3], f64), b: ([f64; 3], f64), c: ([f64; 3], f64)| {
-        let area = scale(cross(sub(b.0, a.0), sub(c.0, a.0)), 0.5);
-        for g in GAUSS {
-            let x = add(add(scale(a.0, g[0]), scale(b.0, g[1])), scale(c.0, g[2]));
-            let q = g[0] * a.1 + g[1] * b.1 + g[2] * c.1;
-            let (k, bary) = nearest(&corners, x);
-            sink(x, scale(area, q / 3.0), candidates[k], bary);
-        }
-    };
-    let p = |v: &Vertex| (v.x, v.q);
-    if poly.len() == 3 {
-        triangle(p(&poly[0]), p(&poly[1]), p(&poly[2]));
+    let m = poly.len();
+    let mut force = [[0.0; 3]; 12];
+    if m == 3 {
+        let f = triangle_forces([0, 1, 2].map(|k| (poly[k].x, poly[k].q)));
+        force[..3].copy_from_slice(&f);
     } else {
-        let c = (centroid(poly), poly.iter().map(|v| v.q).sum::<f64>() / poly.len() as f64);
-        for k in 0..poly.len() {
-            triangle(c, p(&poly[k]), p(&poly[(k + 1) % poly.len()]));
+        let c = (centroid(poly), poly.iter().map(|v| v.q).sum::<f64>() / m as f64);
+        let mut centre = [0.0; 3];
+        for k in 0..m {
+            let (a, b) = (&poly[k], &poly[(k + 1) % m]);
+            let [fc, fa, fb] = triangle_forces([c, (a.x, a.q), (b.x, b.q)]);
+            centre = add(centre, fc);
+            force[k] = add(force[k], fa);
+            force[(k + 1) % m] = add(force[(k + 1) % m], fb);
         }
+        let share = scale(centre, 1.0 / m as f64);
+        force[..m].iter_mut().for_each(|f| *f = add(*f, share));
+    }
+    for (v, f) in poly.iter().zip(&force) {
+        let cut = &view.cuts[v.cut];
+        sink(v.x, *f, cut.triangle, cut.bary);
     }
 }
 
-/// The candidate triangle nearest to `x` and the barycentric coordinates of the closest point.
-fn nearest(corners: &[[[f64; 3]; 3]], x: [f64; 3]) -> (usize, [f64; 3]) {
-    let mut best = (0, [1.0, 0.0, 0.0], f64::INFINITY);
-    for (k, t) in corners.iter().enumerate() {
-        let bary = closest_point(x, t);
-        let y = add(add(scale(t[0], bary[0]), scale(t[1], bary[1])), scale(t[2], bary[2]));
-        let d = norm(sub(x, y));
-        if d < best.2 {
-            best = (k, bary, d);
-        }
-    }
-    (best.0, best.1)
-}
-
-/// Barycentric coordinates of the point of triangle `t` closest to `p` (Ericson, *Real-Time
-/// Collision Detection* §5.1.5).
-fn closest_point(p: [f64; 3], t: &[[f64; 3]; 3]) -> [f64; 3] {
-    let (a, b, c) = (t[0], t[1], t[2]);
-    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let bp = sub(p, b);
-    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return [0.0, 1.0, 0.0];
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return [1.0 - v, v, 0.0];
-    }
-    let cp = sub(p, c);
-    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return [0.0, 0.0, 1.0];
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return [1.0 - w, 0.0, w];
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return [0.0, 1.0 - w, w];
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    [1.0 - v - w, v, w]
+/// `F_k = ∫ q N̂_k n̂` on the triangle of `(x, q)` corners, `q` linear: the area vector times
+/// `(2 q_k + q_l + q_m) / 12` (the rows of the P1 mass matrix; a uniform `q` gives each corner a
+/// third).
+fn triangle_forces(corner: [([f64; 3], f64); 3]) -> [[f64; 3]; 3] {
+    let [(a, qa), (b, qb), (c, qc)] = corner;
+    let area = scale(cross(sub(b, a), sub(c, a)), 0.5);
+    let sum = qa + qb + qc;
+    [qa, qb, qc].map(|q| scale(area, (sum + q) / 12.0))
 }
