@@ -26,9 +26,9 @@ use crate::embedded::generate::{cylinder, plate};
 use crate::embedded::intersect::{collision, projection, Near, SurfaceAt};
 use crate::embedded::motion::RigidMotion;
 use crate::embedded::riemann_fs::{add_wall_fluxes, WallFluxView, WallMaterial};
-use crate::embedded::status::{swept_nodes_among, update_sides, NodeStatus};
+use crate::embedded::status::swept_nodes_among;
 use crate::embedded::step::EmbeddedStep;
-use crate::embedded::tracker::{intersect, Seed, Tracker};
+use crate::embedded::tracker::{Seed, Tracker};
 use crate::embedded::Surface;
 use crate::eos::Eos;
 use crate::flux::FluxScheme;
@@ -302,16 +302,12 @@ fn track(
         stamp("refit", &mut lap);
         let near = Near::find(mesh, &parts.adjacency, &parts.node_boxes, &parts.bvh);
         stamp("near", &mut lap);
-        let cuts =
-            intersect(mesh, &parts.adjacency, &parts.surface, &parts.bvh, spec.tracking, &near)?;
+        let cuts = parts.cuts_near(mesh, &near)?;
         stamp("intersect", &mut lap);
         let swept = swept_nodes_among(mesh, &parts.surface, &parts.bvh, &near.nodes);
         stamp("swept_nodes", &mut lap);
-        let (sides, changes) = update_sides(mesh, &parts.adjacency, &parts.sides, &cuts, &swept);
+        let changes = parts.move_sides(mesh, cuts, &swept, &near);
         stamp("update_sides", &mut lap);
-        parts.active = sides.status.iter().map(|s| *s == NodeStatus::Active).collect();
-        parts.cuts = cuts;
-        parts.sides = sides;
         let cut = parts.cuts.cut_mask(mesh.n_edges());
         let filled = fill_changed(
             mesh,

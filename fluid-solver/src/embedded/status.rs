@@ -49,6 +49,8 @@ pub struct NodeSides {
     pub side: Vec<u32>,
     /// Per side id: whether it is fluid.
     pub side_fluid: Vec<bool>,
+    /// The nodes whose side is [`NO_SIDE`], ascending (a step redecides them).
+    pub unsided: Vec<u32>,
 }
 
 /// A node whose side or status changed in a step.
@@ -140,7 +142,8 @@ pub fn flood_fill(
     }
     let side_fluid: Vec<bool> = classified.iter().map(|c| c.is_some_and(|(_, f)| f)).collect();
     let status = statuses(&side, &side_fluid, &cuts.occluded);
-    Ok(NodeSides { status, side, side_fluid })
+    let unsided = (0..n as u32).filter(|&i| side[i as usize] == NO_SIDE).collect();
+    Ok(NodeSides { status, side, side_fluid, unsided })
 }
 
 /// The nodes a triangle passed over between `x_a` and `x_b` (Alg. 4.2 step 5.1, point against a
@@ -182,8 +185,8 @@ pub fn swept_nodes_among(
 /// Sides after a step (Alg. 4.2 step 5.2): the swept nodes and the nodes occluded before or now
 /// are redecided from their visible neighbours of known side, through the new cut edges, by a
 /// flood fill in node order; those that reach none are inactive. Returns the new sides and the
-/// nodes whose side or status changed (ascending). The fill starts from the neighbours of the
-/// undecided nodes and walks only what it reaches, so its cost follows the surface.
+/// nodes whose side or status changed (ascending). Looks at every node: the reference of
+/// [`update_sides_among`], which the tracker runs.
 pub fn update_sides(
     mesh: &Mesh,
     adjacency: &NodeEdges,
@@ -191,23 +194,56 @@ pub fn update_sides(
     cuts: &Intersections,
     swept: &[u32],
 ) -> (NodeSides, Vec<SideChange>) {
+    let all: Vec<u32> = (0..mesh.n_nodes() as u32).collect();
+    let mut sides = old.clone();
+    let changes = update_sides_among(mesh, adjacency, &mut sides, cuts, swept, &all);
+    (sides, changes)
+}
+
+/// The nodes [`update_sides_among`] must look at: the swept ones, those without a side before
+/// (occluded or undecided: [`NodeSides::unsided`]) and those of `near` occluded now (every
+/// occluded node is near), ascending.
+pub fn redecided(sides: &NodeSides, cuts: &Intersections, swept: &[u32], near: &[u32]) -> Vec<u32> {
+    let occluded = near.iter().copied().filter(|&i| cuts.occluded[i as usize]);
+    let mut nodes: Vec<u32> = swept.iter().chain(&sides.unsided).copied().chain(occluded).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+/// [`update_sides`] in place, looking only at `candidates` (ascending; at least
+/// [`redecided`]). Any other node has a side, is not occluded before or now and is not swept, so
+/// neither its side nor its status can change and it is not in the fill; the fill starts from
+/// the known neighbours of the undecided nodes and walks only what it reaches. Its cost follows
+/// the surface.
+pub fn update_sides_among(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    sides: &mut NodeSides,
+    cuts: &Intersections,
+    swept: &[u32],
+    candidates: &[u32],
+) -> Vec<SideChange> {
     let n = mesh.n_nodes();
-    debug_assert!(old.side.len() == n && cuts.occluded.len() == n, "sides of another mesh");
+    debug_assert!(sides.side.len() == n && cuts.occluded.len() == n, "sides of another mesh");
+    let before: Vec<(u32, NodeStatus)> =
+        candidates.iter().map(|&i| (sides.side[i as usize], sides.status[i as usize])).collect();
     let uncut = |e: u32| cuts.find(e).is_none();
-    let mut side = old.side.clone();
+    let side = &mut sides.side;
     for &i in swept {
         side[i as usize] = NO_SIDE;
     }
-    for i in 0..n {
-        if cuts.occluded[i] {
-            side[i] = NO_SIDE;
+    for &i in candidates {
+        if cuts.occluded[i as usize] {
+            side[i as usize] = NO_SIDE;
         }
     }
-    let unknown: Vec<bool> = (0..n).map(|i| side[i] == NO_SIDE && !cuts.occluded[i]).collect();
+    // Unknown: no side now and not occluded (a candidate; the fill only assigns such nodes).
+    let unknown = |side: &[u32], i: usize| side[i] == NO_SIDE && !cuts.occluded[i];
     // The known nodes next to an unknown one through an uncut edge, in node order.
     let mut queue: Vec<usize> = Vec::new();
-    for u in (0..n).filter(|&u| unknown[u]) {
-        for (j, e) in adjacency.neighbours(mesh, u) {
+    for &u in candidates.iter().filter(|&&u| unknown(&side[..], u as usize)) {
+        for (j, e) in adjacency.neighbours(mesh, u as usize) {
             if side[j] != NO_SIDE && uncut(e) {
                 queue.push(j);
             }
@@ -220,38 +256,45 @@ pub fn update_sides(
         let i = queue[head];
         head += 1;
         for (j, e) in adjacency.neighbours(mesh, i) {
-            if unknown[j] && side[j] == NO_SIDE && uncut(e) {
+            if unknown(&side[..], j) && uncut(e) {
                 side[j] = side[i];
                 queue.push(j);
             }
         }
     }
-    let status = statuses(&side, &old.side_fluid, &cuts.occluded);
-    let changes = (0..n)
-        .filter(|&i| side[i] != old.side[i] || status[i] != old.status[i])
-        .map(|i| SideChange {
-            node: i as u32,
-            old_side: old.side[i],
-            new_side: side[i],
-            old_status: old.status[i],
-            new_status: status[i],
-        })
-        .collect();
-    (NodeSides { status, side, side_fluid: old.side_fluid.clone() }, changes)
+    let mut changes = Vec::new();
+    for (&i, &(old_side, old_status)) in candidates.iter().zip(&before) {
+        let iu = i as usize;
+        let status = status_of(sides.side[iu], &sides.side_fluid, cuts.occluded[iu]);
+        sides.status[iu] = status;
+        if sides.side[iu] != old_side || status != old_status {
+            changes.push(SideChange {
+                node: i,
+                old_side,
+                new_side: sides.side[iu],
+                old_status,
+                new_status: status,
+            });
+        }
+    }
+    sides.unsided =
+        candidates.iter().copied().filter(|&i| sides.side[i as usize] == NO_SIDE).collect();
+    changes
 }
 
 fn statuses(side: &[u32], side_fluid: &[bool], occluded: &[bool]) -> Vec<NodeStatus> {
-    (0..side.len())
-        .map(|i| {
-            if occluded[i] {
-                NodeStatus::Occluded
-            } else if side[i] != NO_SIDE && side_fluid[side[i] as usize] {
-                NodeStatus::Active
-            } else {
-                NodeStatus::Inactive
-            }
-        })
-        .collect()
+    (0..side.len()).map(|i| status_of(side[i], side_fluid, occluded[i])).collect()
+}
+
+#[inline]
+fn status_of(side: u32, side_fluid: &[bool], occluded: bool) -> NodeStatus {
+    if occluded {
+        NodeStatus::Occluded
+    } else if side != NO_SIDE && side_fluid[side as usize] {
+        NodeStatus::Active
+    } else {
+        NodeStatus::Inactive
+    }
 }
 
 /// The step limit of thesis §4.4: the largest ratio, over the surface nodes, of the distance the

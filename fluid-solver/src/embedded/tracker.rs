@@ -3,15 +3,18 @@
 //! surface at `t_b` -> refit -> the mesh nodes and edges the swept boxes reach
 //! ([`super::intersect::near`]) -> intersect (Alg. 4.1 or 4.2 at `x_b`) -> swept nodes and new
 //! sides (Alg. 4.2 step 5) -> the nodes whose status changed, for the solver to fill
-//! ([`super::fill`]). The residual then reads it through [`super::step::Wall`]. Only the flood
-//! fill of Alg. 4.1 and a few streaming passes over the node arrays cost what the grid costs.
+//! ([`super::fill`]). The residual then reads it through [`super::step::Wall`]. Each pass looks
+//! only at the near part: Alg. 4.1 keeps its inside ([`KeptInside`]) and the sides are redecided
+//! only at the swept, occluded and unsided nodes ([`update_sides_among`]).
 
 use super::adjacency::NodeEdges;
 use super::bvh::Bvh;
-use super::intersect::{collision_near, projection_near, Intersections, Near, NodeBoxes};
+use super::intersect::{
+    collision_near, projection_near, Intersections, KeptInside, Near, NodeBoxes,
+};
 use super::intersect::{SurfaceAt, SurfaceAtError};
 use super::riemann_fs::WallPressures;
-use super::status::{flood_fill, step_ratio, swept_nodes_among, update_sides};
+use super::status::{flood_fill, redecided, step_ratio, swept_nodes_among, update_sides_among};
 use super::status::{NodeSides, NodeStatus};
 use super::status::{SideChange, StatusError};
 use super::Surface;
@@ -51,6 +54,8 @@ pub struct Tracker {
     pub active: Vec<bool>,
     /// `p*` on both sides of each cut edge, from the last residual (the loads read it).
     pub p_star: Vec<WallPressures>,
+    /// Alg. 4.1's inside of every node, kept from step to step (`None` for Alg. 4.2).
+    pub kept_inside: Option<KeptInside>,
 }
 
 impl Tracker {
@@ -67,11 +72,31 @@ impl Tracker {
         let bvh = Bvh::build(&surface, PAD * if h.is_finite() { h } else { 0.0 });
         let node_boxes = NodeBoxes::build(mesh, &adjacency);
         let near = Near::find(mesh, &adjacency, &node_boxes, &bvh);
-        let cuts = intersect(mesh, &adjacency, &surface, &bvh, tracking, &near)?;
+        let (cuts, kept_inside) = match tracking {
+            Tracking::Collision => {
+                (intersect(mesh, &adjacency, &surface, &bvh, tracking, &near)?, None)
+            }
+            Tracking::Projection => {
+                let at = SurfaceAt::at_end(&surface, &bvh)?;
+                let (kept, cuts) = KeptInside::new(mesh, &adjacency, at, &near);
+                (cuts, Some(kept))
+            }
+        };
         let sides = flood_fill(mesh, &adjacency, &cuts, seeds)?;
         let active = sides.status.iter().map(|s| *s == NodeStatus::Active).collect();
         let p_star = vec![[f64::NAN; 2]; cuts.cuts.len()];
-        Ok(Tracker { surface, bvh, adjacency, node_boxes, tracking, cuts, sides, active, p_star })
+        Ok(Tracker {
+            surface,
+            bvh,
+            adjacency,
+            node_boxes,
+            tracking,
+            cuts,
+            sides,
+            active,
+            p_star,
+            kept_inside,
+        })
     }
 
     /// Moves the surface to `(x_b, v_b)` at `t_b` and re-tracks it: returns the nodes whose side
@@ -90,17 +115,40 @@ impl Tracker {
         self.surface.advance(t_b, x_b, v_b);
         self.bvh.update(&self.surface);
         let near = Near::find(mesh, &self.adjacency, &self.node_boxes, &self.bvh);
-        let cuts =
-            intersect(mesh, &self.adjacency, &self.surface, &self.bvh, self.tracking, &near)?;
+        let cuts = self.cuts_near(mesh, &near)?;
         let swept = swept_nodes_among(mesh, &self.surface, &self.bvh, &near.nodes);
-        let (sides, changes) = update_sides(mesh, &self.adjacency, &self.sides, &cuts, &swept);
+        Ok(self.move_sides(mesh, cuts, &swept, &near))
+    }
+
+    /// The cut edges of the surface at `x_b` (Alg. 4.1 or 4.2), testing the nodes and edges of
+    /// `near` ([`Near::find`] over the refitted hierarchy); Alg. 4.1 updates its kept inside.
+    pub fn cuts_near(&mut self, mesh: &Mesh, near: &Near) -> Result<Intersections, TrackError> {
+        let at = SurfaceAt::at_end(&self.surface, &self.bvh)?;
+        Ok(match &mut self.kept_inside {
+            Some(kept) => kept.advance(mesh, &self.adjacency, at, near),
+            None => collision_near(mesh, &self.adjacency, at, near),
+        })
+    }
+
+    /// Takes the step's `cuts` and redecides the sides of the `swept` nodes and the occluded
+    /// ones (Alg. 4.2 step 5) among `near`, updating the active flags where they changed: the
+    /// nodes whose side or status changed (ascending).
+    pub fn move_sides(
+        &mut self,
+        mesh: &Mesh,
+        cuts: Intersections,
+        swept: &[u32],
+        near: &Near,
+    ) -> Vec<SideChange> {
+        let candidates = redecided(&self.sides, &cuts, swept, &near.nodes);
+        let changes =
+            update_sides_among(mesh, &self.adjacency, &mut self.sides, &cuts, swept, &candidates);
         self.cuts = cuts;
-        self.sides = sides;
-        for (a, s) in self.active.iter_mut().zip(&self.sides.status) {
-            *a = *s == NodeStatus::Active;
+        for c in &changes {
+            self.active[c.node as usize] = c.new_status == NodeStatus::Active;
         }
         self.p_star = vec![[f64::NAN; 2]; self.cuts.cuts.len()];
-        Ok(changes)
+        changes
     }
 
     /// Thesis §4.4: the largest distance a surface node moved over the step, in fluid edge
@@ -121,6 +169,8 @@ impl Tracker {
             + size_of_val(&self.sides.side[..])
             + size_of_val(&self.active[..])
             + size_of_val(&self.p_star[..])
+            + size_of_val(&self.sides.unsided[..])
+            + self.kept_inside.as_ref().map_or(0, KeptInside::memory_bytes)
     }
 }
 

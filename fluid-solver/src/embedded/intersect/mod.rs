@@ -16,7 +16,7 @@ pub mod projection;
 
 pub use collision::{collision, collision_near};
 pub use near::{Near, NodeBoxes};
-pub use projection::{projection, projection_inside, projection_near};
+pub use projection::{projection, projection_inside, projection_near, KeptInside};
 
 use super::bvh::Bvh;
 use super::predicates::{closest_point, segment_triangle, unit_normal, Closest};
@@ -72,18 +72,6 @@ impl Intersections {
             .map(|b| cuts.partition_point(|c| (c.edge as usize) < blocks.edges(b).start) as u32)
             .collect();
         block_offsets.push(cuts.len() as u32);
-        Intersections { cuts, block_offsets, occluded }
-    }
-
-    /// Gathers the per-block lists (in block order) into one sorted list with offsets.
-    fn from_blocks(blocks: Vec<Vec<CutEdge>>, occluded: Vec<bool>) -> Intersections {
-        let mut block_offsets = Vec::with_capacity(blocks.len() + 1);
-        block_offsets.push(0);
-        let mut cuts = Vec::with_capacity(blocks.iter().map(Vec::len).sum());
-        for b in blocks {
-            cuts.extend_from_slice(&b);
-            block_offsets.push(cuts.len() as u32);
-        }
         Intersections { cuts, block_offsets, occluded }
     }
 }

@@ -95,7 +95,8 @@ mod tests {
     use super::*;
     use crate::embedded::intersect::{collision, collision_near, projection, projection_near};
     use crate::embedded::intersect::{Intersections, SurfaceAt};
-    use crate::embedded::status::{swept_nodes, swept_nodes_among, update_sides};
+    use crate::embedded::status::NodeStatus;
+    use crate::embedded::status::{flood_fill, swept_nodes, swept_nodes_among, update_sides};
     use crate::embedded::tests::{box_surface, cube_mesh, plane, sphere};
     use crate::embedded::tracker::{Seed, Tracker};
     use crate::embedded::Surface;
@@ -159,7 +160,9 @@ mod tests {
     }
 
     /// A sphere moving through a perturbed mesh, by both algorithms: the tracker (which tests
-    /// only the near part) has after every step the cuts and sides of the full passes.
+    /// only the near part, keeps Alg. 4.1's inside and redecides only the swept and occluded
+    /// nodes) has after every step the cuts and sides of the full passes, and the statuses of
+    /// the whole-mesh flood fill from seeds carried with the body (Alg. 4.2 step 5').
     #[test]
     fn a_moving_sphere_is_tracked_as_by_the_full_passes() {
         let mesh = cube_mesh(12, 0.3, 21);
@@ -188,10 +191,45 @@ mod tests {
                     update_sides(&mesh, &tracker.adjacency, &full, &cuts, &swept);
                 assert_eq!(tracker.sides, sides, "{tracking:?}, step {step}");
                 assert_eq!(changes, full_changes);
+                let carried = [
+                    seeds[0],
+                    Seed { point: [0.4 + shift, 0.5, 0.48 + 0.3 * shift], fluid: false },
+                ];
+                let fresh = flood_fill(&mesh, &tracker.adjacency, &cuts, &carried).unwrap();
+                assert_eq!(tracker.sides.status, fresh.status, "{tracking:?}, step {step}");
+                let active = tracker.sides.status.iter().map(|s| *s == NodeStatus::Active);
+                assert!(active.eq(tracker.active.iter().copied()), "{tracking:?}, step {step}");
                 changed += changes.len();
                 full = sides;
             }
             assert!(changed > 40, "{tracking:?}: {changed} nodes changed");
+            // Alg. 4.1 kept its inside through every step (no whole-mesh flood fill).
+            let kept = tracker.kept_inside.as_ref().map(|k| k.full_fills);
+            assert_eq!(kept, (tracking == Tracking::Projection).then_some(0), "{tracking:?}");
+        }
+    }
+
+    /// A sphere that jumps out of the box, moves outside it and jumps back. The swept boxes
+    /// cover each jump, so the nodes it left are near and redecided; outside, no node is near,
+    /// the check (b) of `KeptInside` fails and that step takes the whole-mesh flood fill. Every
+    /// step has the cuts of Alg. 4.1 over the whole mesh.
+    #[test]
+    fn alg_4_1_keeps_the_whole_mesh_result_through_jumps_and_an_empty_near_part() {
+        let mesh = cube_mesh(12, 0.3, 8);
+        let rest = sphere([0.3, 0.5, 0.5], 0.15, 6);
+        let seeds = [Seed { point: [0.0; 3], fluid: true }];
+        let mut tracker = Tracker::new(&mesh, rest.clone(), Tracking::Projection, &seeds).unwrap();
+        for (step, shift, fills, cut) in
+            [(1, 2.0, 0, false), (2, 2.05, 1, false), (3, 0.4, 1, true)]
+        {
+            let x: Vec<[f64; 3]> = rest.x_b.iter().map(|p| [p[0] + shift, p[1], p[2]]).collect();
+            let v = vec![[0.0; 3]; x.len()];
+            tracker.advance(&mesh, 0.1 * step as f64, &x, &v).unwrap();
+            let at = SurfaceAt::at_end(&tracker.surface, &tracker.bvh).unwrap();
+            let cuts = projection(&mesh, &tracker.adjacency, at);
+            assert_eq!(!cuts.cuts.is_empty(), cut, "step {step}");
+            assert_eq!(tracker.cuts, cuts, "step {step}");
+            assert_eq!(tracker.kept_inside.as_ref().unwrap().full_fills, fills, "step {step}");
         }
     }
 }

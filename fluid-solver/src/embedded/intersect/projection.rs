@@ -22,9 +22,13 @@
 use super::{Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::predicates::{closest_point, unit_normal, Closest, Feature};
+use crate::embedded::CutEdge;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
+
+/// Edges per parallel task of step 5.
+const CHUNK: usize = 256;
 
 /// Cut edges and occluded nodes by Alg. 4.1; the inside test is [`projection_inside`]. Tests
 /// every node.
@@ -33,64 +37,210 @@ pub fn projection(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Inte
 }
 
 /// [`projection()`] testing only the nodes of `near` against the surface ([`Near::find`]); the
-/// flood fill and the comparison of the sides of each edge still run over the whole mesh.
+/// flood fill and the comparison of the sides of each edge still run over the whole mesh (the
+/// reference of [`KeptInside`], which does not).
 pub fn projection_near(
     mesh: &Mesh,
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
     near: &Near,
 ) -> Intersections {
-    let inside = inside_among(mesh, adjacency, at, &near.nodes);
-    let occluded = at.occluded(mesh, &adjacency.h_min, false, &near.nodes);
-    let blocks: Vec<_> = (0..mesh.blocks.len())
-        .into_par_iter()
-        .map(|b| {
-            let mut cuts = Vec::new();
-            for e in mesh.blocks.edges(b) {
-                let [i, j] = mesh.edges[e].map(|v| v as usize);
-                if inside[i] == inside[j] {
-                    continue;
-                }
-                if let Some(c) = at.nearest_crossing(mesh, e, false) {
-                    cuts.push(c);
-                    continue;
-                }
-                let (p, q) = (mesh.coords[i], mesh.coords[j]);
-                let d = sub(q, p);
-                let l2 = dot(d, d);
-                let mid = add(p, scale(d, 0.5));
-                if let Some((t, cp)) = at.nearest_point(mid, l2.sqrt(), false) {
-                    let [a, b, c] = at.corners(t);
-                    let x =
-                        add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
-                    let alpha = (dot(sub(x, p), d) / l2).clamp(0.0, 1.0);
-                    cuts.push(at.cut(e, t, alpha, cp.bary));
-                }
-            }
-            cuts
-        })
-        .collect();
-    Intersections::from_blocks(blocks, occluded)
+    whole_mesh(mesh, adjacency, at, near).2
 }
 
 /// Per node: inside the closed surface (Alg. 4.1 steps 1-4).
 pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Vec<bool> {
     let all: Vec<u32> = (0..mesh.n_nodes() as u32).collect();
-    inside_among(mesh, adjacency, at, &all)
+    flood(mesh, adjacency, &all, decide(mesh, adjacency, at, &all))
 }
 
-/// [`projection_inside`] with steps 1-3 run only at `candidates` (ascending; a node whose box
-/// meets no triangle box is not near and is left to the flood fill).
-fn inside_among(
+/// Steps 1-4 over the whole mesh from the near nodes: the inside of every node, the edges whose
+/// ends differ (ascending) and the cut edges.
+fn whole_mesh(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    at: SurfaceAt<'_>,
+    near: &Near,
+) -> (Vec<bool>, Vec<u32>, Intersections) {
+    let inside = flood(mesh, adjacency, &near.nodes, decide(mesh, adjacency, at, &near.nodes));
+    let differ: Vec<u32> =
+        (0..mesh.n_edges() as u32).filter(|&e| differs(mesh, &inside, e)).collect();
+    let cuts = cut_edges(mesh, adjacency, at, near, &differ);
+    (inside, differ, cuts)
+}
+
+/// Alg. 4.1 from step to step at the cost of the surface (the tracker's form of
+/// [`projection_near`], same result): the inside of every node and the edges whose ends differ
+/// are kept, and a step redecides only the near nodes (steps 1-3).
+///
+/// Why the far nodes keep their inside: let `D` be the near nodes decided by steps 1-3 and `U`
+/// the others. The flood fill of step 4 gives each node of `U` a value carried from `D` along
+/// paths through `U` only, so if (a) every edge with an end in `U` has equal insides at its ends
+/// and (b) every connected part of the mesh holds a node of `D`, each connected patch of `U`
+/// takes the one value of the `D` nodes around it: the kept value. A node of `U` is not swept
+/// (a swept node lies in a swept triangle box, so it is near), so on a closed, resolved surface
+/// whose nodes move less than an edge per step (thesis §4.4) its side does not change, and (a)
+/// and (b) hold. They are checked every step, cheaply: an edge where (a) can fail is near (it
+/// touches a node of `D`) or kept as differing from the last step; where one fails the step
+/// takes the whole-mesh flood fill instead ([`KeptInside::full_fills`] counts them). Step 5 then
+/// tests only the differing edges, all of them near.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeptInside {
+    inside: Vec<bool>,
+    /// Edges whose ends differ, ascending.
+    differ: Vec<u32>,
+    /// Connected part of the mesh of each node, and their number.
+    part: Vec<u32>,
+    n_parts: usize,
+    /// Steps that fell back on the whole-mesh flood fill.
+    pub full_fills: usize,
+}
+
+impl KeptInside {
+    /// The inside at the first step, by the whole-mesh passes, with the cuts.
+    pub fn new(
+        mesh: &Mesh,
+        adjacency: &NodeEdges,
+        at: SurfaceAt<'_>,
+        near: &Near,
+    ) -> (KeptInside, Intersections) {
+        let (inside, differ, cuts) = whole_mesh(mesh, adjacency, at, near);
+        let (part, n_parts) = connected_parts(mesh, adjacency);
+        (KeptInside { inside, differ, part, n_parts, full_fills: 0 }, cuts)
+    }
+
+    /// The cuts of the next step ([`projection_near`] at the surface `at`, whose swept boxes give
+    /// `near`).
+    pub fn advance(
+        &mut self,
+        mesh: &Mesh,
+        adjacency: &NodeEdges,
+        at: SurfaceAt<'_>,
+        near: &Near,
+    ) -> Intersections {
+        let decided = decide(mesh, adjacency, at, &near.nodes);
+        if !self.update_near(mesh, near, &decided) {
+            self.full_fills += 1;
+            self.inside = flood(mesh, adjacency, &near.nodes, decided);
+            self.differ =
+                (0..mesh.n_edges() as u32).filter(|&e| differs(mesh, &self.inside, e)).collect();
+        }
+        cut_edges(mesh, adjacency, at, near, &self.differ)
+    }
+
+    /// Sets the decided near nodes and checks (a) and (b) of the type's docs; on success the
+    /// differing edges are the near ones.
+    fn update_near(&mut self, mesh: &Mesh, near: &Near, decided: &[Option<bool>]) -> bool {
+        let mut reached = vec![false; self.n_parts];
+        for (&i, d) in near.nodes.iter().zip(decided) {
+            if let Some(v) = *d {
+                self.inside[i as usize] = v;
+                reached[self.part[i as usize] as usize] = true;
+            }
+        }
+        let inside = &self.inside;
+        let in_d = |i: u32| near.nodes.binary_search(&i).is_ok_and(|k| decided[k].is_some());
+        let breaks_a = |&e: &u32| {
+            let [i, j] = mesh.edges[e as usize];
+            differs(mesh, inside, e) && !(in_d(i) && in_d(j))
+        };
+        if !reached.iter().all(|r| *r)
+            || near.edges.par_iter().any(breaks_a)
+            || self.differ.par_iter().any(breaks_a)
+        {
+            return false;
+        }
+        self.differ =
+            near.edges.par_iter().copied().filter(|&e| differs(mesh, inside, e)).collect();
+        true
+    }
+
+    /// Memory in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(&self.inside[..]) + size_of_val(&self.differ[..]) + size_of_val(&self.part[..])
+    }
+}
+
+/// Whether the ends of edge `e` differ in `inside`.
+#[inline]
+fn differs(mesh: &Mesh, inside: &[bool], e: u32) -> bool {
+    let [i, j] = mesh.edges[e as usize];
+    inside[i as usize] != inside[j as usize]
+}
+
+/// The connected parts of the mesh through its edges: the part of each node and their number.
+fn connected_parts(mesh: &Mesh, adjacency: &NodeEdges) -> (Vec<u32>, usize) {
+    let n = mesh.n_nodes();
+    let mut part = vec![u32::MAX; n];
+    let mut queue = Vec::new();
+    let mut n_parts = 0u32;
+    for start in 0..n {
+        if part[start] != u32::MAX {
+            continue;
+        }
+        part[start] = n_parts;
+        queue.clear();
+        queue.push(start);
+        while let Some(i) = queue.pop() {
+            for (j, _) in adjacency.neighbours(mesh, i) {
+                if part[j] == u32::MAX {
+                    part[j] = n_parts;
+                    queue.push(j);
+                }
+            }
+        }
+        n_parts += 1;
+    }
+    (part, n_parts as usize)
+}
+
+/// Step 5 over `differ` (the edges whose ends differ, ascending): each is cut where it crosses
+/// the triangles near it, else at the surface point nearest to its midpoint; the occluded nodes
+/// among the near ones.
+fn cut_edges(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    at: SurfaceAt<'_>,
+    near: &Near,
+    differ: &[u32],
+) -> Intersections {
+    let occluded = at.occluded(mesh, &adjacency.h_min, false, &near.nodes);
+    let cuts: Vec<CutEdge> = differ
+        .par_chunks(CHUNK)
+        .flat_map_iter(|chunk| chunk.iter().filter_map(|&e| edge_cut(mesh, at, e as usize)))
+        .collect();
+    Intersections::from_sorted(mesh, cuts, occluded)
+}
+
+/// The cut of edge `e`, whose ends differ.
+fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, e: usize) -> Option<CutEdge> {
+    if let Some(c) = at.nearest_crossing(mesh, e, false) {
+        return Some(c);
+    }
+    let [i, j] = mesh.edges[e].map(|v| v as usize);
+    let (p, q) = (mesh.coords[i], mesh.coords[j]);
+    let d = sub(q, p);
+    let l2 = dot(d, d);
+    let mid = add(p, scale(d, 0.5));
+    let (t, cp) = at.nearest_point(mid, l2.sqrt(), false)?;
+    let [a, b, c] = at.corners(t);
+    let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
+    let alpha = (dot(sub(x, p), d) / l2).clamp(0.0, 1.0);
+    Some(at.cut(e, t, alpha, cp.bary))
+}
+
+/// Steps 1-3 at `candidates` (ascending): each near node decided by its closest point (`None`
+/// for a node whose box meets no triangle box: left to the flood fill).
+fn decide(
     mesh: &Mesh,
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
     candidates: &[u32],
-) -> Vec<bool> {
+) -> Vec<Option<bool>> {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     let normals = PseudoNormals::new(at);
-    // Steps 1-3: the near nodes, decided by their closest point.
-    let decided: Vec<Option<bool>> = candidates
+    candidates
         .par_iter()
         .map(|&i| {
             let i = i as usize;
@@ -115,12 +265,22 @@ fn inside_among(
             let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
             Some(dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0)
         })
-        .collect();
+        .collect()
+}
+
+/// Step 4: the nodes of `candidates` take their `decided` side, the others that of the nearest
+/// decided node by a flood fill in node order; a part of the mesh with no decided node is
+/// outside.
+fn flood(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    candidates: &[u32],
+    decided: Vec<Option<bool>>,
+) -> Vec<bool> {
     let mut inside: Vec<Option<bool>> = vec![None; mesh.n_nodes()];
     for (&i, d) in candidates.iter().zip(decided) {
         inside[i as usize] = d;
     }
-    // Step 4: flood fill from the decided nodes, in node order.
     let mut queue: Vec<usize> = (0..mesh.n_nodes()).filter(|&i| inside[i].is_some()).collect();
     let mut head = 0;
     while head < queue.len() {
