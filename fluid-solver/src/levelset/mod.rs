@@ -9,6 +9,11 @@
 //!    whose material changed takes the ghost state of the exact two-phase Riemann problem on its
 //!    edges to nodes of its new fluid ([`ghost`]), its conserved variables recomputed with the new
 //!    EOS, and the operator's layout (special edges, masked gradients) is rebuilt;
+//!    Within each RK2 stage a node below its material's cavitation cut-off (DESIGN §5.1: the
+//!    vapour pressure of water for a liquid, none for a perfect gas; the cut-off of the
+//!    two-phase Riemann problems too, [`crate::two_phase::cutoff`]) is clipped to it
+//!    ([`crate::eos::Eos::cut_off`]: a gas at fixed density and velocity, a Tait liquid to the
+//!    density of `p_cut`), each clip counted ([`InterfaceStep::clips`]);
 //! 3. every `reinit_every` steps `φ` is reset to a signed distance with the nodes of
 //!    sign-changing edges frozen ([`reinit`]), so reinitialisation never moves the interface and
 //!    never changes a material.
@@ -30,6 +35,7 @@ pub mod reinit;
 use crate::bc::BoundaryCondition;
 use crate::embedded::adjacency::NodeEdges;
 use crate::reconstruct::gradient::LsqGradient;
+use crate::riemann::PressureCutoff;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::state::{MaterialId, State, Workspace};
 use crate::time::rk2::rk2_step_level_set;
@@ -50,6 +56,9 @@ pub struct LevelSet {
     pub adjacency: NodeEdges,
     /// The nodes on far-field, inflow and outflow boundaries (first-order `φ` there, [`advect`]).
     pub open: Vec<bool>,
+    /// The nodal cavitation cut-off of every material id
+    /// ([`crate::riemann::PressureCutoff::default_for`]; `-∞`: none).
+    pub p_cut: Vec<f64>,
 }
 
 /// Scratch arrays of the level set, allocated once per mesh.
@@ -94,6 +103,8 @@ pub struct InterfaceStep {
     pub changed: usize,
     /// Whether `φ` was reinitialised after the step.
     pub reinitialised: bool,
+    /// Node states clipped to the cavitation cut-off in the step's two stages.
+    pub clips: u64,
 }
 
 impl LevelSet {
@@ -118,6 +129,7 @@ impl LevelSet {
             gradient: gradient::phi_gradient(semi),
             adjacency: NodeEdges::build(&semi.mesh),
             open,
+            p_cut: semi.eos.iter().map(|e| PressureCutoff::default_for(e).p_cut).collect(),
         }
     }
 
@@ -174,7 +186,8 @@ impl LevelSet {
         step_number: u64,
     ) -> Result<InterfaceStep, FluidError> {
         let mut next = state.clone();
-        let dt = rk2_step_level_set(semi, self, &mut next, ws, lws, stepping, dt_max)?;
+        let mut clips = 0;
+        let dt = rk2_step_level_set(semi, self, &mut next, ws, lws, stepping, dt_max, &mut clips)?;
         let moved = next.phi.iter().zip(&next.material).any(|(&p, &m)| self.material_of(p) != m);
         if moved {
             // The interface normals of the ghost states: ∇φⁿ⁺¹.
@@ -197,6 +210,6 @@ impl LevelSet {
             reinit::reinitialise(&semi.mesh, &self.adjacency, &lws.grad, &mut next.phi);
         }
         *state = next;
-        Ok(InterfaceStep { dt, changed, reinitialised })
+        Ok(InterfaceStep { dt, changed, reinitialised, clips })
     }
 }

@@ -7,6 +7,7 @@ use crate::embedded::tracker::Tracker;
 use crate::levelset::{advect, LevelSet, LevelSetWorkspace};
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::state::{State, Workspace};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Advances `state` by one RK2 step no longer than `dt_max`; returns the (global) step taken
 /// (for local stepping, the smallest node step). Each stage's update is applied inside the
@@ -20,7 +21,8 @@ pub fn rk2_step(
     dt_max: f64,
 ) -> Result<f64, FluidError> {
     let steps = NodeSteps::new(semi, &state.cons, ws, stepping, dt_max)?;
-    let result = stages(semi, &mut state.cons, ws, |i| steps.ratio(semi, i), None, |_, _| {});
+    let ratio = |i| steps.ratio(semi, i);
+    let result = stages(semi, &mut state.cons, ws, ratio, None, |_, _| {}, |_, _| {});
     steps.finish(ws, result)
 }
 
@@ -70,8 +72,10 @@ impl NodeSteps {
 /// [`rk2_step`] of the flow and the level set together (thesis Eq. 3.8 with 3.10-3.13): each
 /// stage advances `φ` with the velocities of that stage's flow state by the same update
 /// ([`advect`]), `φ¹ = φⁿ - Δt/|C| R^φ(φⁿ, Wⁿ)`, `φⁿ⁺¹ = ½ φⁿ + ½ (φ¹ - Δt/|C| R^φ(φ¹, W¹))`, on the
-/// material layout of `semi` (the caller updates the materials afterwards). On error `state` is
-/// unchanged.
+/// material layout of `semi` (the caller updates the materials afterwards). After each stage's
+/// update a node below its material's cavitation cut-off is clipped ([`crate::eos::Eos::cut_off`]
+/// with `ls.p_cut`); the clips of the step are added to `clips`. On error `state` is unchanged.
+#[allow(clippy::too_many_arguments)]
 pub fn rk2_step_level_set(
     semi: &Semidiscretization,
     ls: &LevelSet,
@@ -80,6 +84,7 @@ pub fn rk2_step_level_set(
     lws: &mut LevelSetWorkspace,
     stepping: TimeStepping,
     dt_max: f64,
+    clips: &mut u64,
 ) -> Result<f64, FluidError> {
     let steps = NodeSteps::new(semi, &state.cons, ws, stepping, dt_max)?;
     let ratio = |i: usize| steps.ratio(semi, i);
@@ -88,8 +93,15 @@ pub fn rk2_step_level_set(
     let phi_n = &phi[..];
     let limiter = semi.numerics.limiter;
     let mesh = &semi.mesh;
+    let clipped = AtomicU64::new(0);
+    let cut_off = |i: usize, q: &mut [f64; 5]| {
+        let m = semi.material()[i] as usize;
+        if semi.eos[m].cut_off(q, ls.p_cut[m]) {
+            clipped.fetch_add(1, Ordering::Relaxed);
+        }
+    };
     // `ws.prim` holds the primitives of the stage's flow state when each stage's flow pass ends.
-    let result = stages(semi, cons, ws, ratio, None, |stage, ws| {
+    let result = stages(semi, cons, ws, ratio, None, cut_off, |stage, ws| {
         // The stage's φ (φⁿ, then φ¹) into the advection workspace.
         let source: &[f64] = if stage == 0 { phi_n } else { &phi_stage };
         for (s, p) in lws.phi.iter_mut().zip(source) {
@@ -113,6 +125,7 @@ pub fn rk2_step_level_set(
     });
     if result.is_ok() {
         std::mem::swap(phi, &mut phi_stage);
+        *clips += clipped.into_inner();
     }
     lws.stage = phi_stage;
     steps.finish(ws, result)
@@ -133,11 +146,12 @@ pub fn rk2_step_embedded(
     let ratio = |i: usize| if tracker.active[i] { dt / semi.mesh.volumes[i] } else { 0.0 };
     let (t_a, t_b) = (tracker.surface.t_a, tracker.surface.t_b);
     let walls = [Wall { step, tracker, t: t_a }, Wall { step, tracker, t: t_b }];
-    stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {})
+    stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {}, |_, _| {})
 }
 
 /// The two stages with `ratio(i) = Δt_i / |C_i|` (zero freezes a node), each with its wall; the
-/// new state is built in `ws.stage` and swapped in at the end. After each stage's pass,
+/// new state is built in `ws.stage` and swapped in at the end. Each node's new stage state
+/// passes through `floor(i, &mut W_i)` as soon as it is updated. After each stage's pass,
 /// `after(stage, ws)` runs with `ws.prim` still the primitives that pass read (of `Wⁿ`, then of
 /// `W¹`).
 fn stages(
@@ -146,6 +160,7 @@ fn stages(
     ws: &mut Workspace,
     ratio: impl Fn(usize) -> f64 + Sync,
     walls: Option<[Wall<'_>; 2]>,
+    floor: impl Fn(usize, &mut [f64; 5]) + Sync,
     mut after: impl FnMut(usize, &mut Workspace),
 ) -> Result<(), FluidError> {
     let mut stage = std::mem::take(&mut ws.stage);
@@ -159,6 +174,7 @@ fn stages(
             for k in 0..5 {
                 w1[k] = cons[i][k] - a * r[k];
             }
+            floor(i, w1);
         },
         walls.map(|w| w[0]),
     );
@@ -176,6 +192,7 @@ fn stages(
                     for k in 0..5 {
                         w[k] = 0.5 * cons[i][k] + 0.5 * (w[k] - a * r[k]);
                     }
+                    floor(i, w);
                 },
                 walls.map(|w| w[1]),
             )
