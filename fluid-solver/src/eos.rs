@@ -230,6 +230,43 @@ impl Eos {
         [rho, u, v, w, self.pressure(rho, e)]
     }
 
+    /// The nodal cavitation cut-off (DESIGN §5.1): a node whose pressure lies below `p_cut` is
+    /// set to `p_cut` at fixed density and velocity (its energy recomputed); returns whether it
+    /// was. A barotropic liquid has no pressure to set at fixed density (`p = p(ρ)`), and since
+    /// `p(ρ)` increases, `p >= p_cut` is `ρ >= ρ_cut = ρ(p_cut)`: the cut-off is a density floor,
+    /// the node set to `ρ_cut` at fixed velocity, the state the Riemann cut-off gives on a Tait
+    /// wave curve at `p_cut` ([`crate::riemann::PressureCutoff`]). That adds mass
+    /// `(ρ_cut - ρ)|C_i|`, which the caller counts with the clip. A cut-off at or below the lowest
+    /// pressure of the EOS, or a state with a non-positive or non-finite density, is left alone
+    /// (for [`Eos::check`] to report).
+    pub fn cut_off(&self, q: &mut [f64; 5], p_cut: f64) -> bool {
+        let rho = q[0];
+        let acts = if self.is_barotropic() {
+            p_cut >= self.min_pressure()
+        } else {
+            p_cut > self.min_pressure()
+        };
+        if !(acts && rho > 0.0 && rho.is_finite()) {
+            return false;
+        }
+        let mut w = self.cons_to_prim(q);
+        if self.is_barotropic() {
+            let rho_cut = self.tait_density(p_cut);
+            if !(rho < rho_cut) {
+                return false;
+            }
+            w[0] = rho_cut;
+            w[4] = p_cut;
+        } else {
+            if !(w[4] < p_cut) {
+                return false;
+            }
+            w[4] = p_cut;
+        }
+        *q = self.prim_to_cons(&w);
+        true
+    }
+
     /// Checks a primitive state against the domain of the EOS.
     pub fn check(&self, w: &[f64; 5]) -> Result<(), StateError> {
         let [rho, u, v, wz, p] = *w;
@@ -379,6 +416,46 @@ mod tests {
             other => panic!("expected cavitation, got {other:?}"),
         }
         assert!(gas.check(&[1.0, f64::NAN, 0.0, 0.0, 1.0]).is_err());
+    }
+
+    /// The nodal cut-off: a gas keeps its density and velocity and takes `p_cut`; Tait takes
+    /// `ρ(p_cut)` at its velocity (a density floor); states above the cut-off, and cut-offs
+    /// below the EOS's lowest pressure, are untouched.
+    #[test]
+    fn the_cut_off_sets_the_pressure_at_fixed_density_or_the_tait_density_floor() {
+        let p_cut = 2339.0;
+        for eos in eoses() {
+            let above = sample_state(&eos);
+            let mut q = eos.prim_to_cons(&above);
+            let before = q;
+            assert!(!eos.cut_off(&mut q, p_cut), "{eos:?}");
+            assert_eq!(q, before);
+            let low = match eos {
+                Eos::Tait { .. } => {
+                    let rho = 0.999 * eos.tait_density(0.0);
+                    [rho, 3.0, -1.0, 0.5, eos.tait_pressure(rho)]
+                }
+                Eos::PerfectGas { .. } => [1.2, 3.0, -1.0, 0.5, 100.0],
+                Eos::StiffenedGas { .. } => [1000.0, 3.0, -1.0, 0.5, -1e7],
+            };
+            let mut q = eos.prim_to_cons(&low);
+            assert!(eos.cut_off(&mut q, p_cut), "{eos:?}");
+            let w = eos.cons_to_prim(&q);
+            let rho = if eos.is_barotropic() { eos.tait_density(p_cut) } else { low[0] };
+            assert!((w[0] - rho).abs() <= 1e-14 * rho, "{eos:?}: {w:?}");
+            assert!(eos.is_barotropic() || w[0] == low[0]);
+            for k in 1..4 {
+                assert!((w[k] - low[k]).abs() <= 1e-12, "{eos:?}: velocity {w:?}");
+            }
+            assert!((w[4] - p_cut).abs() <= 1e-9 * eos.stiffness().1.max(p_cut), "{eos:?} {w:?}");
+            assert_eq!(eos.check(&w), Ok(()));
+            // Off (the default of a perfect gas), or below the EOS's own limit: untouched.
+            let mut q = eos.prim_to_cons(&low);
+            assert!(!eos.cut_off(&mut q, f64::NEG_INFINITY) && q == eos.prim_to_cons(&low));
+        }
+        let gas = Eos::PerfectGas { gamma: 1.4 };
+        let mut q = gas.prim_to_cons(&[1.2, 0.0, 0.0, 0.0, 100.0]);
+        assert!(!gas.cut_off(&mut q, -5.0));
     }
 
     #[test]

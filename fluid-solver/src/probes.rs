@@ -117,9 +117,15 @@ impl Line {
         self.pending.first().is_some_and(|&lt| reached(t, lt))
     }
 
-    /// The samples of the current state: primitive variables and material id (`material`
-    /// column, the fluid's id in the EOS table) of each point's node.
-    pub fn sample(&self, prim: &[[f64; 5]], material: &[MaterialId]) -> Vec<LinePoint> {
+    /// The samples of the current state: primitive variables, material id (`material` column,
+    /// the fluid's id in the EOS table) and level set (`phi`: NaN when `phi` is empty, a run
+    /// without a level set) of each point's node.
+    pub fn sample(
+        &self,
+        prim: &[[f64; 5]],
+        material: &[MaterialId],
+        phi: &[f64],
+    ) -> Vec<LinePoint> {
         let from = self.points[0];
         self.points
             .iter()
@@ -133,6 +139,7 @@ impl Line {
                     v: [w[1], w[2], w[3]],
                     p: w[4],
                     material: u32::from(material[i]),
+                    phi: phi.get(i).copied().unwrap_or(f64::NAN),
                 }
             })
             .collect()

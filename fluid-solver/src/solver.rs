@@ -132,6 +132,8 @@ pub struct FluidRun<'a> {
     embedded: Option<EmbeddedRun>,
     /// The moving interface of `[fluid.level_set]`.
     level_set: Option<(LevelSet, LevelSetWorkspace)>,
+    /// Node states clipped to the cavitation cut-off (level-set runs), in `run.json`.
+    cavitation_clips: u64,
 }
 
 impl<'a> FluidRun<'a> {
@@ -252,6 +254,7 @@ impl<'a> FluidRun<'a> {
             status: Ok(()),
             embedded,
             level_set,
+            cavitation_clips: 0,
         };
         run.write_probes()?;
         // Lines asked for at the start time.
@@ -321,7 +324,7 @@ impl<'a> FluidRun<'a> {
                     line.pending.remove(0);
                 }
                 let name = format!("{}_t{t:.6e}", line.name);
-                let sample = line.sample(&self.ws.prim, &self.state.material);
+                let sample = line.sample(&self.ws.prim, &self.state.material, &self.state.phi);
                 write_line_sample(&self.out.lines()?, &name, &sample)?;
             }
         }
@@ -358,7 +361,10 @@ impl<'a> FluidRun<'a> {
                         stop - t,
                         step + 1,
                     )
-                    .map(|s| s.dt)
+                    .map(|s| {
+                        self.cavitation_clips += s.clips;
+                        s.dt
+                    })
                     .map_err(anyhow::Error::from),
                 (None, None) => {
                     rk2_step(&self.semi, &mut self.state, &mut self.ws, self.stepping, stop - t)
@@ -486,7 +492,7 @@ impl<'a> FluidRun<'a> {
                 output::write_fields(&mut self.fields, &self.semi, self.t, &self.ws.prim, phi)?;
             }
             for line in &self.lines {
-                let sample = line.sample(&self.ws.prim, &self.state.material);
+                let sample = line.sample(&self.ws.prim, &self.state.material, &self.state.phi);
                 write_line_sample(&self.out.lines()?, &line.name, &sample)?;
             }
             self.timers.add_since(bucket::OUTPUT, start);
@@ -510,6 +516,7 @@ impl<'a> FluidRun<'a> {
                 self.t,
                 &self.timers,
                 self.wall,
+                self.cavitation_clips,
             )?;
         }
         match self.status {
@@ -544,6 +551,7 @@ fn write_report(
     time: f64,
     timers: &Timers,
     wall: Instant,
+    cavitation_clips: u64,
 ) -> anyhow::Result<()> {
     let mut versions = report::versions();
     versions.insert("fluid-solver".into(), env!("CARGO_PKG_VERSION").into());
@@ -561,6 +569,7 @@ fn write_report(
             ("nodes".to_string(), semi.mesh.n_nodes() as u64),
             ("edges".to_string(), semi.mesh.n_edges() as u64),
             ("cells".to_string(), semi.mesh.cells.len() as u64),
+            ("cavitation_clips".to_string(), cavitation_clips),
         ]
         .into(),
         wall_seconds: wall.elapsed().as_secs_f64(),

@@ -9,6 +9,11 @@
 //!    whose material changed takes the ghost state of the exact two-phase Riemann problem on its
 //!    edges to nodes of its new fluid ([`ghost`]), its conserved variables recomputed with the new
 //!    EOS, and the operator's layout (special edges, masked gradients) is rebuilt;
+//!    Within each RK2 stage a node below its material's cavitation cut-off (DESIGN §5.1: the
+//!    vapour pressure of water for a liquid, none for a perfect gas; the cut-off of the
+//!    two-phase Riemann problems too, [`crate::two_phase::cutoff`]) is clipped to it
+//!    ([`crate::eos::Eos::cut_off`]: a gas at fixed density and velocity, a Tait liquid to the
+//!    density of `p_cut`), each clip counted ([`InterfaceStep::clips`]);
 //! 3. every `reinit_every` steps `φ` is reset to a signed distance with the nodes of
 //!    sign-changing edges frozen ([`reinit`]), so reinitialisation never moves the interface and
 //!    never changes a material.
@@ -34,6 +39,7 @@ pub mod reinit;
 use crate::bc::BoundaryCondition;
 use crate::embedded::adjacency::NodeEdges;
 use crate::reconstruct::gradient::LsqGradient;
+use crate::riemann::PressureCutoff;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::state::{MaterialId, State, Workspace};
 use crate::time::rk2::rk2_step_level_set;
@@ -54,6 +60,9 @@ pub struct LevelSet {
     pub adjacency: NodeEdges,
     /// The nodes on far-field, inflow and outflow boundaries (first-order `φ` there, [`advect`]).
     pub open: Vec<bool>,
+    /// The nodal cavitation cut-off of every material id
+    /// ([`crate::riemann::PressureCutoff::default_for`]; `-∞`: none).
+    pub p_cut: Vec<f64>,
 }
 
 /// Scratch arrays of the level set, allocated once per mesh.
@@ -98,6 +107,8 @@ pub struct InterfaceStep {
     pub changed: usize,
     /// Whether `φ` was reinitialised after the step.
     pub reinitialised: bool,
+    /// Node states clipped to the cavitation cut-off in the step's two stages.
+    pub clips: u64,
 }
 
 impl LevelSet {
@@ -122,6 +133,7 @@ impl LevelSet {
             gradient: gradient::phi_gradient(semi),
             adjacency: NodeEdges::build(&semi.mesh),
             open,
+            p_cut: semi.eos.iter().map(|e| PressureCutoff::default_for(e).p_cut).collect(),
         }
     }
 
@@ -178,11 +190,12 @@ impl LevelSet {
         step_number: u64,
     ) -> Result<InterfaceStep, FluidError> {
         let mut next = state.clone();
-        let dt = rk2_step_level_set(semi, self, &mut next, ws, lws, stepping, dt_max)?;
+        let mut clips = 0;
+        let dt = rk2_step_level_set(semi, self, &mut next, ws, lws, stepping, dt_max, &mut clips)?;
         let (changed, reinitialised) =
             self.after_flow(semi, &mut next, lws, &self.gradient, None, step_number)?;
         *state = next;
-        Ok(InterfaceStep { dt, changed, reinitialised })
+        Ok(InterfaceStep { dt, changed, reinitialised, clips })
     }
 
     /// Steps 2 and 3 of the module docs once `state` holds the flow and `φ` at `t^{n+1}`: the

@@ -8,6 +8,7 @@ use crate::levelset::{advect, LevelSet, LevelSetWorkspace};
 use crate::reconstruct::gradient::LsqGradient;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::state::{State, Workspace};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Advances `state` by one RK2 step no longer than `dt_max`; returns the (global) step taken
 /// (for local stepping, the smallest node step). Each stage's update is applied inside the
@@ -21,7 +22,8 @@ pub fn rk2_step(
     dt_max: f64,
 ) -> Result<f64, FluidError> {
     let steps = NodeSteps::new(semi, &state.cons, ws, stepping, dt_max)?;
-    let result = stages(semi, &mut state.cons, ws, |i| steps.ratio(semi, i), None, |_, _| {});
+    let ratio = |i| steps.ratio(semi, i);
+    let result = stages(semi, &mut state.cons, ws, ratio, None, |_, _| {}, |_, _| {});
     steps.finish(ws, result)
 }
 
@@ -71,8 +73,10 @@ impl NodeSteps {
 /// [`rk2_step`] of the flow and the level set together (thesis Eq. 3.8 with 3.10-3.13): each
 /// stage advances `φ` with the velocities of that stage's flow state by the same update
 /// ([`advect`]), `φ¹ = φⁿ - Δt/|C| R^φ(φⁿ, Wⁿ)`, `φⁿ⁺¹ = ½ φⁿ + ½ (φ¹ - Δt/|C| R^φ(φ¹, W¹))`, on the
-/// material layout of `semi` (the caller updates the materials afterwards). On error `state` is
-/// unchanged.
+/// material layout of `semi` (the caller updates the materials afterwards). After each stage's
+/// update a node below its material's cavitation cut-off is clipped ([`crate::eos::Eos::cut_off`]
+/// with `ls.p_cut`); the clips of the step are added to `clips`. On error `state` is unchanged.
+#[allow(clippy::too_many_arguments)]
 pub fn rk2_step_level_set(
     semi: &Semidiscretization,
     ls: &LevelSet,
@@ -81,11 +85,22 @@ pub fn rk2_step_level_set(
     lws: &mut LevelSetWorkspace,
     stepping: TimeStepping,
     dt_max: f64,
+    clips: &mut u64,
 ) -> Result<f64, FluidError> {
     let steps = NodeSteps::new(semi, &state.cons, ws, stepping, dt_max)?;
     let advection = PhiAdvection { gradient: &ls.gradient, open: &ls.open, through: None };
     let ratio = |i: usize| steps.ratio(semi, i);
-    let result = stages_with_phi(semi, state, ws, ratio, None, (advection, lws));
+    let clipped = AtomicU64::new(0);
+    let cut_off = |i: usize, q: &mut [f64; 5]| {
+        let m = semi.material()[i] as usize;
+        if semi.eos[m].cut_off(q, ls.p_cut[m]) {
+            clipped.fetch_add(1, Ordering::Relaxed);
+        }
+    };
+    let result = stages_with_phi(semi, state, ws, ratio, None, cut_off, (advection, lws));
+    if result.is_ok() {
+        *clips += clipped.into_inner();
+    }
     steps.finish(ws, result)
 }
 
@@ -117,20 +132,22 @@ pub fn rk2_step_embedded(
     let (t_a, t_b) = (tracker.surface.t_a, tracker.surface.t_b);
     let walls = [Wall { step, tracker, t: t_a }, Wall { step, tracker, t: t_b }];
     match level_set {
-        Some(phi) => stages_with_phi(semi, state, ws, ratio, Some(walls), phi),
-        None => stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {}),
+        Some(phi) => stages_with_phi(semi, state, ws, ratio, Some(walls), |_, _| {}, phi),
+        None => stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {}, |_, _| {}),
     }
 }
 
 /// The two stages of the flow (with `walls`, if any) and of `φ` by `advection` with the
-/// velocities of each stage's flow state; `φ^{n+1}` is built in `lws.stage` and swapped into
-/// `state.phi` with the flow, so on error `state` is unchanged.
+/// velocities of each stage's flow state, each node's flow state through `floor` as in
+/// [`stages`]; `φ^{n+1}` is built in `lws.stage` and swapped into `state.phi` with the flow, so
+/// on error `state` is unchanged.
 fn stages_with_phi(
     semi: &Semidiscretization,
     state: &mut State,
     ws: &mut Workspace,
     ratio: impl Fn(usize) -> f64 + Sync,
     walls: Option<[Wall<'_>; 2]>,
+    floor: impl Fn(usize, &mut [f64; 5]) + Sync,
     (advection, lws): (PhiAdvection<'_>, &mut LevelSetWorkspace),
 ) -> Result<(), FluidError> {
     let mut phi_stage = std::mem::take(&mut lws.stage);
@@ -140,7 +157,7 @@ fn stages_with_phi(
     let mesh = &semi.mesh;
     let ratio = &ratio;
     // `ws.prim` holds the primitives of the stage's flow state when each stage's flow pass ends.
-    let result = stages(semi, cons, ws, ratio, walls, |stage, ws| {
+    let result = stages(semi, cons, ws, ratio, walls, floor, |stage, ws| {
         // The stage's φ (φⁿ, then φ¹) into the advection workspace.
         let source: &[f64] = if stage == 0 { phi_n } else { &phi_stage };
         for (s, p) in lws.phi.iter_mut().zip(source) {
@@ -171,7 +188,8 @@ fn stages_with_phi(
 }
 
 /// The two stages with `ratio(i) = Δt_i / |C_i|` (zero freezes a node), each with its wall; the
-/// new state is built in `ws.stage` and swapped in at the end. After each stage's pass,
+/// new state is built in `ws.stage` and swapped in at the end. Each node's new stage state
+/// passes through `floor(i, &mut W_i)` as soon as it is updated. After each stage's pass,
 /// `after(stage, ws)` runs with `ws.prim` still the primitives that pass read (of `Wⁿ`, then of
 /// `W¹`).
 fn stages(
@@ -180,6 +198,7 @@ fn stages(
     ws: &mut Workspace,
     ratio: impl Fn(usize) -> f64 + Sync,
     walls: Option<[Wall<'_>; 2]>,
+    floor: impl Fn(usize, &mut [f64; 5]) + Sync,
     mut after: impl FnMut(usize, &mut Workspace),
 ) -> Result<(), FluidError> {
     let mut stage = std::mem::take(&mut ws.stage);
@@ -193,6 +212,7 @@ fn stages(
             for k in 0..5 {
                 w1[k] = cons[i][k] - a * r[k];
             }
+            floor(i, w1);
         },
         walls.map(|w| w[0]),
     );
@@ -210,6 +230,7 @@ fn stages(
                     for k in 0..5 {
                         w[k] = 0.5 * cons[i][k] + 0.5 * (w[k] - a * r[k]);
                     }
+                    floor(i, w);
                 },
                 walls.map(|w| w[1]),
             )

@@ -3,7 +3,9 @@
 //! - `probes.csv`: `time,<probe>.rho,<probe>.vx,<probe>.vy,<probe>.vz,<probe>.p` per fluid probe;
 //! - `structure_probes.csv`:
 //!   `time,<probe>.ux,<probe>.uy,<probe>.uz,<probe>.vx,<probe>.vy,<probe>.vz`;
-//! - `lines/<name>.csv`: `x,y,z,s,rho,vx,vy,vz,p,material`, one row per sample point.
+//! - `lines/<name>.csv`: `x,y,z,s,rho,vx,vy,vz,p,material,phi`, one row per sample point
+//!   (`phi` the level set, `NaN` when the run has none: appended last, so readers by position
+//!   of the first ten columns are unaffected).
 //!
 //! Numbers are written in Rust's shortest round-trip exponent form (`1.5e-3`), which Python,
 //! numpy and pandas parse back to the same `f64`.
@@ -17,7 +19,7 @@ pub const FLUID_COMPONENTS: &[&str] = &["rho", "vx", "vy", "vz", "p"];
 /// Components of a structure probe, in column order.
 pub const STRUCTURE_COMPONENTS: &[&str] = &["ux", "uy", "uz", "vx", "vy", "vz"];
 /// Header of a line sample file.
-pub const LINE_HEADER: &str = "x,y,z,s,rho,vx,vy,vz,p,material";
+pub const LINE_HEADER: &str = "x,y,z,s,rho,vx,vy,vz,p,material,phi";
 
 /// A probe or line-sample file could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -152,6 +154,8 @@ pub struct LinePoint {
     pub p: f64,
     /// Material (fluid phase) id, or a ghost/inactive marker chosen by the solver.
     pub material: u32,
+    /// Level set at the point (`NaN` when the run has none).
+    pub phi: f64,
 }
 
 /// Writes `lines_dir/<name>.csv` (atomically) with [`LINE_HEADER`] and one row per point.
@@ -176,6 +180,8 @@ pub fn write_line_sample(
                 line.push(',');
             }
             line.push_str(&pt.material.to_string());
+            line.push(',');
+            push_number(&mut line, pt.phi);
             line.push('\n');
             w.write_all(line.as_bytes())?;
         }
@@ -261,6 +267,7 @@ mod tests {
                     v: [x * x, 0.0, -x],
                     p: 1e5 * (1.0 - x),
                     material: i % 2,
+                    phi: if i == 4 { f64::NAN } else { x - 0.25 },
                 }
             })
             .collect();
@@ -270,6 +277,8 @@ mod tests {
         assert_eq!(text.lines().next().unwrap(), LINE_HEADER);
         let rows = parse(&text);
         assert_eq!(rows.len(), 5);
+        // No level set: `NaN`, which Rust, Python and numpy read back as NaN.
+        assert!(text.lines().nth(5).unwrap().ends_with(",0,NaN"), "{text}");
         for (pt, row) in pts.iter().zip(&rows) {
             let expect = [
                 pt.x[0],
@@ -282,8 +291,10 @@ mod tests {
                 pt.v[2],
                 pt.p,
                 pt.material as f64,
+                pt.phi,
             ];
-            assert_eq!(row.as_slice(), expect.as_slice());
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(row), bits(&expect), "{row:?} vs {expect:?}");
         }
         assert!(write_line_sample(dir.path(), "../x", &pts).is_err());
     }
