@@ -121,7 +121,7 @@ impl<const N: usize> Neg for Lanes<N> {
 }
 
 impl<const N: usize> Real for Lanes<N> {
-    type Mask = [bool; N];
+    type Mask = [u64; N];
     #[inline(always)]
     fn splat(v: f64) -> Self {
         Lanes([v; N])
@@ -142,16 +142,19 @@ impl<const N: usize> Real for Lanes<N> {
     fn min(self, o: Self) -> Self {
         Lanes(std::array::from_fn(|i| if self.0[i] < o.0[i] { self.0[i] } else { o.0[i] }))
     }
+    /// All bits set where true: the form of a vector comparison, so `select` is a blend.
     #[inline(always)]
-    fn gt(self, o: Self) -> [bool; N] {
-        std::array::from_fn(|i| self.0[i] > o.0[i])
+    fn gt(self, o: Self) -> [u64; N] {
+        std::array::from_fn(|i| if self.0[i] > o.0[i] { u64::MAX } else { 0 })
     }
     #[inline(always)]
-    fn select(m: [bool; N], a: Self, b: Self) -> Self {
-        Lanes(std::array::from_fn(|i| if m[i] { a.0[i] } else { b.0[i] }))
+    fn select(m: [u64; N], a: Self, b: Self) -> Self {
+        Lanes(std::array::from_fn(|i| {
+            f64::from_bits((a.0[i].to_bits() & m[i]) | (b.0[i].to_bits() & !m[i]))
+        }))
     }
     #[inline(always)]
-    fn any(m: [bool; N]) -> bool {
-        m.iter().any(|&b| b)
+    fn any(m: [u64; N]) -> bool {
+        m.iter().fold(0, |acc, &v| acc | v) != 0
     }
 }

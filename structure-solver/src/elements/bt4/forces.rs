@@ -7,7 +7,9 @@
 //! 2. nodes, a node's force summing its elements' contributions in ascending element order
 //!    (`elements::incidence`), exactly the order of a serial scatter.
 //!
-//! So the forces are bitwise independent of the thread count and of rayon's splitting.
+//! So the forces are bitwise independent of the thread count and of rayon's splitting. On one
+//! thread the blocks add their forces to the nodes as they go, in ascending element order: the
+//! same sums without the work array.
 //!
 //! The vector width is chosen at run time ([`SimdPath`]): the block loop is compiled for
 //! AVX-512 (x86-64-v4), AVX2 + FMA (x86-64-v3) and the baseline (SSE2) through `pulp`, and
@@ -67,7 +69,7 @@ impl SimdPath {
     }
 
     /// Runs `op` compiled for this path; `None` when the processor lacks it.
-    fn run<Op: pulp::WithSimd>(self, op: Op) -> Option<Op::Output> {
+    pub(super) fn run<Op: pulp::WithSimd>(self, op: Op) -> Option<Op::Output> {
         use pulp::Simd;
         match self {
             #[cfg(target_arch = "x86_64")]
@@ -97,17 +99,26 @@ pub(super) struct Bt4View<'a> {
     pub settings: &'a super::Bt4Settings,
 }
 
+/// Where a task puts its element forces.
+enum Sink<'a> {
+    /// Its rows of the work array.
+    Rows(&'a mut [f64]),
+    /// Added to the nodal forces (6 per node) in element order.
+    Nodes(&'a mut [f64]),
+}
+
 /// The blocks of one task.
 struct BlockTask<'a> {
     shared: &'a Shared<'a>,
     first_block: usize,
+    n_blocks: usize,
     stress_old: &'a [f64],
     alpha_old: &'a [f64],
     hg_old: &'a [f64],
     stress_new: &'a mut [f64],
     alpha_new: &'a mut [f64],
     hg_new: &'a mut [f64],
-    forces: &'a mut [f64],
+    forces: Sink<'a>,
 }
 
 impl pulp::WithSimd for BlockTask<'_> {
@@ -120,14 +131,13 @@ impl pulp::WithSimd for BlockTask<'_> {
 
 impl BlockTask<'_> {
     #[inline(always)]
-    fn run(self) {
+    fn run(mut self) {
         let Shared { bt4, x_end, du } = *self.shared;
         let np = bt4.settings.rule.len();
         let ne = bt4.conn.len();
         let (ns, na) = (np * N_STRESS * LANES, np * LANES);
         let nh = N_HOURGLASS * LANES;
-        let n_blocks = self.forces.len() / (LANES * F_PER_ELEMENT);
-        for j in 0..n_blocks {
+        for j in 0..self.n_blocks {
             let e0 = (self.first_block + j) * LANES;
             let valid = (ne - e0).min(LANES);
             // Gather: padded lanes repeat the block's last element.
@@ -139,12 +149,13 @@ impl BlockTask<'_> {
                 let c = &bt4.conn[el(l)];
                 for i in 0..4 {
                     let n = c[i] as usize;
+                    let (p, d) = (&x_end[n], &du[6 * n..6 * n + 6]);
                     for k in 0..3 {
-                        xe[i][k].0[l] = x_end[n][k];
-                        xm[i][k].0[l] = x_end[n][k] - 0.5 * du[6 * n + k];
+                        xe[i][k].0[l] = p[k];
+                        xm[i][k].0[l] = p[k] - 0.5 * d[k];
                     }
                     for k in 0..6 {
-                        dv[i][k].0[l] = du[6 * n + k];
+                        dv[i][k].0[l] = d[k];
                     }
                 }
             }
@@ -171,11 +182,26 @@ impl BlockTask<'_> {
                     hg_new: &mut self.hg_new[j * nh..(j + 1) * nh],
                 },
             );
-            let out = &mut self.forces[j * LANES * F_PER_ELEMENT..(j + 1) * LANES * F_PER_ELEMENT];
-            for l in 0..LANES {
-                for i in 0..4 {
-                    for d in 0..6 {
-                        out[(l * 4 + i) * 6 + d] = fe[i][d].0[l];
+            match &mut self.forces {
+                Sink::Rows(rows) => {
+                    let n = LANES * F_PER_ELEMENT;
+                    let out = &mut rows[j * n..(j + 1) * n];
+                    for l in 0..LANES {
+                        for i in 0..4 {
+                            for d in 0..6 {
+                                out[(l * 4 + i) * 6 + d] = fe[i][d].0[l];
+                            }
+                        }
+                    }
+                }
+                Sink::Nodes(f) => {
+                    for l in 0..valid {
+                        for (i, &n) in bt4.conn[e0 + l].iter().enumerate() {
+                            let fnode = &mut f[6 * n as usize..6 * n as usize + 6];
+                            for d in 0..6 {
+                                fnode[d] += fe[i][d].0[l];
+                            }
+                        }
                     }
                 }
             }
@@ -215,11 +241,26 @@ pub(super) fn internal_force(
         work.incidence = Incidence::new(bt4.conn, nn);
     }
     let nb = bt4.conn.len().div_ceil(LANES);
-    work.forces.resize(nb * LANES * F_PER_ELEMENT, 0.0);
     let np = bt4.settings.rule.len();
     let t = BLOCKS_PER_TASK;
     let (old, new) = state;
     let shared = Shared { bt4, x_end, du };
+    if rayon::current_num_threads() == 1 {
+        let op = BlockTask {
+            shared: &shared,
+            first_block: 0,
+            n_blocks: nb,
+            stress_old: &old.stress,
+            alpha_old: &old.alpha,
+            hg_old: &old.hourglass,
+            stress_new: &mut new.stress,
+            alpha_new: &mut new.alpha,
+            hg_new: &mut new.hourglass,
+            forces: Sink::Nodes(f),
+        };
+        return path.run(op);
+    }
+    work.forces.resize(nb * LANES * F_PER_ELEMENT, 0.0);
     (
         old.stress.par_chunks(t * np * N_STRESS * LANES),
         old.alpha.par_chunks(t * np * LANES),
@@ -235,13 +276,14 @@ pub(super) fn internal_force(
             let op = BlockTask {
                 shared: &shared,
                 first_block: task * t,
+                n_blocks: fo.len() / (LANES * F_PER_ELEMENT),
                 stress_old: so,
                 alpha_old: ao,
                 hg_old: ho,
                 stress_new: sn,
                 alpha_new: an,
                 hg_new: hn,
-                forces: fo,
+                forces: Sink::Rows(fo),
             };
             path.run(op).expect("a supported path");
         });

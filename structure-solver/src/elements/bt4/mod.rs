@@ -28,13 +28,15 @@
 
 mod forces;
 mod kernel;
+mod step_bound;
 
 pub use forces::{SimdPath, BLOCKS_PER_TASK};
 
-use super::section::{RotaryInertia, SHEAR_FACTOR};
+use super::section::RotaryInertia;
 use crate::elements::add_node_masses;
 use crate::material::{ThicknessRule, J2};
 use kernel::{frame, Constants};
+use step_bound::BoundConstants;
 
 /// Elements per block.
 pub const LANES: usize = 8;
@@ -105,6 +107,7 @@ pub struct Bt4 {
     /// Index into `materials` per element.
     material_of: Vec<u16>,
     constants: Vec<Constants<f64>>,
+    bounds: Vec<BoundConstants<f64>>,
     committed: Bt4State,
     trial: Bt4State,
     work: forces::Work,
@@ -161,6 +164,7 @@ impl Bt4 {
             thickness,
             settings,
             constants: materials.iter().map(Constants::of).collect(),
+            bounds: materials.iter().map(BoundConstants::of).collect(),
             materials,
             material_of,
             committed: state.clone(),
@@ -296,32 +300,22 @@ impl Bt4 {
     /// `A / max(side)`; the diagonal leaves room for the hourglass stiffness), and the rotational
     /// bound `2/ω_r`, `ω_r² = (12 κ G + 4 E h²/A) / (ρ (h² + a))` of the transverse-shear and
     /// bending modes of a node's rotary inertia `m (h² + a)/12` (`a = A` when scaled, else 0).
+    /// Blocks of [`LANES`] elements on the widest vector unit, over the threads of the current
+    /// pool.
     pub fn stable_dt(&self, x: &[[f64; 3]]) -> f64 {
-        use rayon::prelude::*;
-        (0..self.conn.len())
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|e| self.element_stable_dt(e, x))
-            .reduce(|| f64::INFINITY, f64::min)
+        step_bound::stable_dt(SimdPath::detected(), &self.view(), &self.bounds, x)
+            .expect("the detected path is supported")
     }
 
-    fn element_stable_dt(&self, e: usize, x: &[[f64; 3]]) -> f64 {
-        let (conn, h) = (self.conn[e], self.thickness[e]);
-        let el = self.material(e).elastic;
-        let c = el.plate_wave_speed();
-        let xe = conn.map(|n| x[n as usize]);
-        let a = frame(&xe).area;
-        let d = |i: usize, j: usize| {
-            ((xe[i][0] - xe[j][0]).powi(2)
-                + (xe[i][1] - xe[j][1]).powi(2)
-                + (xe[i][2] - xe[j][2]).powi(2))
-            .sqrt()
-        };
-        let l = a / d(0, 2).max(d(1, 3));
-        let a_rot = self.settings.rotary.added_area(a);
-        let w2 = (12.0 * SHEAR_FACTOR * el.shear_modulus() + 4.0 * el.e * h * h / a)
-            / (el.rho * (h * h + a_rot));
-        (l / c).min(2.0 / w2.sqrt())
+    /// The parts the kernels read.
+    fn view(&self) -> forces::Bt4View<'_> {
+        forces::Bt4View {
+            conn: &self.conn,
+            thickness: &self.thickness,
+            constants: &self.constants,
+            material_of: &self.material_of,
+            settings: &self.settings,
+        }
     }
 
     /// Adds the internal forces (6 per node, global frame) of the step with end positions
