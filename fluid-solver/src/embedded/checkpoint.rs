@@ -18,7 +18,7 @@
 
 use super::advance::{EmbeddedRun, Kinematics};
 use super::case::Prescribed;
-use super::intersect::Near;
+use super::intersect::{KeptInside, Near, SurfaceAt};
 use super::riemann_fs::WallPressures;
 use super::status::{NodeSides, NodeStatus, NO_SIDE};
 use super::surface::HermitePath;
@@ -126,7 +126,15 @@ impl EmbeddedRun {
         tracker.bvh.update(&tracker.surface);
         let near = Near::find(mesh, &tracker.adjacency, &tracker.node_boxes, &tracker.bvh);
         let (adjacency, bvh) = (&tracker.adjacency, &tracker.bvh);
-        tracker.cuts = intersect(mesh, adjacency, &tracker.surface, bvh, tracker.tracking, &near)?;
+        if tracker.tracking == Tracking::Projection {
+            // Alg. 4.1 keeps its inside from step to step: rebuilt by the whole-mesh passes.
+            let at = SurfaceAt::at_end(&tracker.surface, bvh)?;
+            let (kept, cuts) = KeptInside::new(mesh, adjacency, at, &near);
+            (tracker.cuts, tracker.kept_inside) = (cuts, Some(kept));
+        } else {
+            tracker.cuts =
+                intersect(mesh, adjacency, &tracker.surface, bvh, tracker.tracking, &near)?;
+        }
         tracker.active = saved.sides.status.iter().map(|s| *s == NodeStatus::Active).collect();
         tracker.sides = saved.sides;
         tracker.p_star = saved.p_star;
@@ -410,7 +418,8 @@ impl EmbeddedCheckpoint {
                 )));
             }
         }
-        Ok(NodeSides { status, side: side.to_vec(), side_fluid })
+        let unsided = (0..n as u32).filter(|&i| side[i as usize] == NO_SIDE).collect();
+        Ok(NodeSides { status, side: side.to_vec(), side_fluid, unsided })
     }
 }
 

@@ -72,7 +72,7 @@ impl Plate {
 
     fn step(&mut self) -> anyhow::Result<f64> {
         let (semi, state, ws) = (&mut self.semi, &mut self.state, &mut self.ws);
-        let dt = self.run.step(semi, state, ws, 0.5, self.t, 1.0)?;
+        let dt = self.run.step(semi, state, ws, 0.5, self.t, 1.0, None)?;
         self.t += dt;
         Ok(dt)
     }
@@ -167,7 +167,7 @@ fn an_undone_step_leaves_everything_as_it_was() {
         let mut undo = Undo::default();
         let (semi, state, ws) = (&mut p.semi, &mut p.state, &mut p.ws);
         let saved = p.run.save();
-        p.run.try_step(semi, state, ws, 0.5, p.t, 1.0, &mut undo).unwrap();
+        p.run.try_step(semi, state, ws, 0.5, p.t, 1.0, None, &mut undo).unwrap();
         assert!(undo.stepped);
         filled += undo.filled.len();
         material_changes += undo.material.is_some() as usize;
