@@ -13,6 +13,7 @@
 
 pub mod bc;
 pub mod bench;
+pub mod bench_bubble;
 pub mod bench_embedded;
 pub mod check;
 pub mod couple;

@@ -2,7 +2,7 @@
 //! checks a case without running it (`check`), or measures its speed (`bench`).
 
 use clap::{Parser, Subcommand};
-use fluid_solver::{bench, bench_embedded, check, couple, solver};
+use fluid_solver::{bench, bench_bubble, bench_embedded, check, couple, solver};
 use interface_protocol::cli::{CheckArgs, RunArgs};
 use interface_protocol::io::outdir;
 use std::path::PathBuf;
@@ -36,7 +36,9 @@ enum Command {
         #[command(flatten)]
         args: CheckArgs,
     },
-    /// Measure node-steps per second per core of RK2 + MUSCL + Roe on a tet box; prints JSON.
+    /// Measure node-steps per second per core of RK2 + MUSCL + Roe on a tet box (one and two
+    /// materials) and of the level-set case `cases/underwater-bubble` (key `level_set`); prints
+    /// JSON.
     Bench {
         /// Approximate number of nodes.
         #[arg(long, default_value_t = 200_000)]
@@ -72,6 +74,8 @@ fn main() -> ExitCode {
         Command::Bench { nodes, steps, threads, dump_edges, embedded } => {
             bench::run(nodes, steps, &threads, dump_edges.as_deref()).and_then(|report| {
                 let mut json = serde_json::to_value(&report)?;
+                json["level_set"] =
+                    serde_json::to_value(bench_bubble::run(nodes, steps, &threads)?)?;
                 if embedded {
                     json["embedded"] =
                         serde_json::to_value(bench_embedded::run(nodes, steps, &report)?)?;

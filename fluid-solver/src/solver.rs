@@ -277,6 +277,11 @@ impl<'a> FluidRun<'a> {
         &self.semi
     }
 
+    /// The state reached: conserved variables, node materials and level set.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
     /// The primitive states `[ρ, u, v, w, p]` of the last step that computed them (at least the
     /// start and every step with output).
     pub fn primitives(&self) -> &[[f64; 5]] {

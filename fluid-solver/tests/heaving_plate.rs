@@ -9,6 +9,9 @@
 //! `HEAVING_PLATE_PNG=<path>` to choose where; the case folder's picture is the full case at
 //! t = 5 ms, drawn by `HEAVING_PLATE_PNG=cases/heaving-plate/pressure.png HEAVING_PLATE_END=5e-3`).
 
+mod common;
+
+use common::plot::diverging;
 use fluid_solver::embedded::loads::{nodal_loads, LoadAlgorithm, LoadView};
 use fluid_solver::eos::Eos;
 use fluid_solver::riemann::simple_wave::SimpleWave;
@@ -156,17 +159,6 @@ fn run(t_end: f64, out: &Path, at: &[f64]) -> (Vec<[f64; 3]>, Vec<[f64; 5]>, Vec
     let (state, _, _) = solver::read_checkpoint(out, summary.nodes).unwrap();
     let eos = Eos::PerfectGas { gamma: 1.4 };
     (coords, state.cons.iter().map(|q| eos.cons_to_prim(q)).collect(), samples)
-}
-
-/// A blue-white-red colour for `v` in `[-1, 1]`.
-fn diverging(v: f64) -> RGBColor {
-    let v = v.clamp(-1.0, 1.0);
-    let fade = |c: f64| (255.0 * (1.0 - v.abs()) + c * v.abs()) as u8;
-    if v >= 0.0 {
-        RGBColor(fade(200.0), fade(30.0), fade(30.0))
-    } else {
-        RGBColor(fade(30.0), fade(60.0), fade(200.0))
-    }
 }
 
 /// Draws `p - p0` at the nodes of the plane `y = y_plane` (one square per node of side `h`) and

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod msh;
+pub mod plot;
 
 use fluid_solver::bc::BoundaryCondition;
 use fluid_solver::eos::Eos;
