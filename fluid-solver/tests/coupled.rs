@@ -10,6 +10,8 @@
 
 mod common;
 
+use common::lines::rows;
+
 use common::ExactTube;
 use fluid_solver::eos::Eos;
 use fluid_solver::solver::{FluidRun, Mode, RunOptions};
@@ -120,16 +122,6 @@ fn expect_reply(link: &mut LauncherLink, command: &Command, kind: u32) -> Reply 
 
 fn header(step: u64, time: f64) -> StepHeader {
     StepHeader { step, time, dt: 0.025, topology_version: 1, count: 0 }
-}
-
-/// Rows of a CSV file as numbers (header skipped).
-fn rows(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|s| s.parse().unwrap()).collect())
-        .collect()
 }
 
 fn assert_same_rows(a: &Path, b: &Path) {

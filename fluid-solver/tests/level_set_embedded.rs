@@ -11,6 +11,9 @@
 //! - `cases/shell-water-air` with the level set on (the interface on the shell, the swept nodes
 //!   changing fluid): bitwise the state without it, `φ` consistent with the materials.
 
+mod common;
+
+use common::lines::{plateau, rows as line};
 use fluid_solver::bc::BoundaryCondition;
 use fluid_solver::embedded::generate::plate;
 use fluid_solver::embedded::step::{EmbeddedStep, Wall};
@@ -275,24 +278,6 @@ fields_every = 0
 checkpoint_every = 0
 "#
     )
-}
-
-/// Rows `x,y,z,s,rho,vx,vy,vz,p,material` of a line file.
-fn line(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|s| s.parse().unwrap()).collect())
-        .collect()
-}
-
-/// Means of `(ρ, u, p)` over the samples with `x` in `[a, b]`.
-fn plateau(rows: &[Vec<f64>], a: f64, b: f64) -> [f64; 3] {
-    let inside: Vec<&Vec<f64>> = rows.iter().filter(|r| (a..=b).contains(&r[0])).collect();
-    assert!(inside.len() > 10, "{} samples in [{a}, {b}]", inside.len());
-    let n = inside.len() as f64;
-    [4, 5, 8].map(|k| inside.iter().map(|r| r[k]).sum::<f64>() / n)
 }
 
 /// The first sample from `from` towards `to` where `p` passes `level`.

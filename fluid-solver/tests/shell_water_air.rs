@@ -15,6 +15,9 @@
 //! Build the binaries first: `cargo build --release -p coupler-scripts -p rigid-structure -p
 //! fluid-solver --bins`.
 
+mod common;
+
+use common::lines::{plateau, rows as line};
 use fluid_solver::eos::{Eos, EosSpec};
 use fluid_solver::riemann::{RiemannSolution, State1d};
 use fluid_solver::solver::{self, RunOptions};
@@ -72,16 +75,6 @@ fn run_coupled(o: &[String], out: &Path) {
     assert!(r.status.success(), "fsi run: {}", String::from_utf8_lossy(&r.stderr));
 }
 
-/// Rows `x,y,z,s,rho,vx,vy,vz,p,material` of a line file.
-fn line(path: &Path) -> Vec<Vec<f64>> {
-    std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|s| s.parse().unwrap()).collect())
-        .collect()
-}
-
 /// The exact solution: water left of the wall (x < 10 t) and air right of it, each the one-sided
 /// Riemann problem of a wall moving at +10 m/s; air is the mirror image of a fluid left of a wall
 /// at -10 m/s.
@@ -128,14 +121,6 @@ impl Exact {
         }
         lo
     }
-}
-
-/// Means of `(ρ, u, p)` over the samples with `x` in `[a, b]`.
-fn plateau(rows: &[Vec<f64>], a: f64, b: f64) -> [f64; 3] {
-    let inside: Vec<&Vec<f64>> = rows.iter().filter(|r| (a..=b).contains(&r[0])).collect();
-    assert!(inside.len() > 10, "{} samples in [{a}, {b}]", inside.len());
-    let n = inside.len() as f64;
-    [4, 5, 8].map(|k| inside.iter().map(|r| r[k]).sum::<f64>() / n)
 }
 
 /// The first sample, walking from the left end (or the right end), where `p` passes `level`.

@@ -202,6 +202,34 @@ fn copies_on_new_nodes_carry_their_state_and_leave_the_plate_unchanged() {
     assert!(apart > 1e-4, "the copy moves on its own ({apart:e} m)");
 }
 
+/// Checkpoints `(m, cd)` as step `step`, runs both 100 more steps of `dt`, and restarts `fresh`
+/// (the model its mesh builds) from the checkpoint for the same 100 steps: the restarted model,
+/// its integrator and the checkpoint read back.
+fn through_checkpoint(
+    m: &mut FeModel,
+    cd: &mut CentralDifference,
+    dt: f64,
+    step: u64,
+    mut fresh: FeModel,
+) -> (FeModel, CentralDifference, Checkpoint) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("structure.ckpt");
+    let mut ck = Checkpoint::new(step, cd.state.t);
+    save_state(m, &mut ck).unwrap();
+    save_dynamics(&mut ck, &cd.state).unwrap();
+    ck.write_file(&path).unwrap();
+    for _ in 0..100 {
+        cd.step(m, dt, None);
+    }
+    let ck = Checkpoint::read_file(&path).unwrap();
+    restore_state(&mut fresh, &ck).unwrap();
+    let mut cr = CentralDifference::resume(&fresh, load_dynamics(&ck, fresh.n_dof()).unwrap());
+    for _ in 0..100 {
+        cr.step(&mut fresh, dt, None);
+    }
+    (fresh, cr, ck)
+}
+
 #[test]
 fn restart_after_a_change_ends_where_the_uninterrupted_run_ends() {
     let dt = 0.5 * plate(&mesh(), &[]).stable_dt();
@@ -210,25 +238,9 @@ fn restart_after_a_change_ends_where_the_uninterrupted_run_ends() {
     for _ in 0..50 {
         cd.step(&mut m, dt, None);
     }
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("structure.ckpt");
-    let mut ck = Checkpoint::new(150, cd.state.t);
-    save_state(&m, &mut ck).unwrap();
-    save_dynamics(&mut ck, &cd.state).unwrap();
-    ck.write_file(&path).unwrap();
-    for _ in 0..100 {
-        cd.step(&mut m, dt, None);
-    }
-
-    let ck = Checkpoint::read_file(&path).unwrap();
-    let mut r = plate(&mesh(), &[]);
-    restore_state(&mut r, &ck).unwrap();
+    let (r, cr, ck) = through_checkpoint(&mut m, &mut cd, dt, 150, plate(&mesh(), &[]));
     assert_eq!(r.topology_version(), m.topology_version());
     assert_eq!(r.topology().elements().ids(), m.topology().elements().ids());
-    let mut cr = CentralDifference::resume(&r, load_dynamics(&ck, r.n_dof()).unwrap());
-    for _ in 0..100 {
-        cr.step(&mut r, dt, None);
-    }
     assert!(model_bits(&r) == model_bits(&m), "restarted model state differs");
     assert!(dynamics_bits(&cr.state) == dynamics_bits(&cd.state), "restarted motion differs");
 
@@ -422,22 +434,7 @@ fn triangles_are_copied_with_their_state_and_restart_across_the_change() {
     for _ in 0..50 {
         cd.step(&mut m, dt, None);
     }
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("structure.ckpt");
-    let mut ck = Checkpoint::new(200, cd.state.t);
-    save_state(&m, &mut ck).unwrap();
-    save_dynamics(&mut ck, &cd.state).unwrap();
-    ck.write_file(&path).unwrap();
-    for _ in 0..100 {
-        cd.step(&mut m, dt, None);
-    }
-    let ck = Checkpoint::read_file(&path).unwrap();
-    let mut r = triangle_plate(&base);
-    restore_state(&mut r, &ck).unwrap();
-    let mut cr = CentralDifference::resume(&r, load_dynamics(&ck, r.n_dof()).unwrap());
-    for _ in 0..100 {
-        cr.step(&mut r, dt, None);
-    }
+    let (r, cr, _) = through_checkpoint(&mut m, &mut cd, dt, 200, triangle_plate(&base));
     assert!(triangle_bits(&r) == triangle_bits(&m), "restarted model state differs");
     assert!(dynamics_bits(&cr.state) == dynamics_bits(&cd.state), "restarted motion differs");
 }

@@ -2,6 +2,7 @@
 //! shock-tube solutions, error norms and the committed JSON references.
 #![allow(dead_code)]
 
+pub mod lines;
 pub mod msh;
 pub mod plot;
 
