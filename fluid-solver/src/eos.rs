@@ -252,13 +252,14 @@ impl Eos {
         let mut w = self.cons_to_prim(q);
         if self.is_barotropic() {
             let rho_cut = self.tait_density(p_cut);
-            if !(rho < rho_cut) {
+            // Not below the floor, or no comparable floor (NaN): nothing to clip.
+            if rho.partial_cmp(&rho_cut) != Some(std::cmp::Ordering::Less) {
                 return false;
             }
             w[0] = rho_cut;
             w[4] = p_cut;
         } else {
-            if !(w[4] < p_cut) {
+            if w[4].partial_cmp(&p_cut) != Some(std::cmp::Ordering::Less) {
                 return false;
             }
             w[4] = p_cut;
