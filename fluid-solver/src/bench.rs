@@ -150,13 +150,15 @@ pub fn run(
 
 /// γ of the single-material row's perfect gas.
 const GAMMA: f64 = 1.4;
+/// The far-field state `[ρ, u, v, w, p]` of the single-material box.
+pub(crate) const FREE_STREAM: [f64; 5] = [1.0, 0.3, 0.1, 0.0, 1.0];
 
 /// The single-material row's scheme and state on `mesh`: a perfect gas between far-field
 /// boundaries, `[ρ, u, v, w, p] = [1 + 0.2s, 0.3 + 0.1s, 0.1, 0.05s, 1 + 0.3s]` with
 /// `s = sin 6x cos 5y sin(4z + 1)`.
 pub(crate) fn single_material(mesh: Mesh) -> anyhow::Result<(Semidiscretization, State)> {
     let eos = Eos::PerfectGas { gamma: GAMMA };
-    let free = [1.0, 0.3, 0.1, 0.0, 1.0];
+    let free = FREE_STREAM;
     let bcs: Vec<(String, BoundaryCondition)> = FACE_NAMES
         .iter()
         .map(|f| (f.to_string(), BoundaryCondition::FarField { state: free }))

@@ -23,7 +23,7 @@ pub enum FluidError {
         position: [f64; 3],
         error: RiemannError,
     },
-    #[error("{0}")]
+    #[error(transparent)]
     Wall(#[from] crate::embedded::riemann_fs::WallFluxError),
     #[error("ghost state of node {node} changing from material {} to {} (x = {position:?}): {error}", materials[0], materials[1])]
     Ghost { node: usize, materials: [MaterialId; 2], position: [f64; 3], error: RiemannError },

@@ -297,7 +297,10 @@ impl EmbeddedRun {
         let start = std::time::Instant::now();
         semi.primitives(&state.cons, ws)?;
         if step.interface == InterfaceTreatment::SecondOrder {
-            step.gradient.compute(&semi.mesh, &ws.prim, &mut ws.grad);
+            // `p*` reads the gradients at the active ends of the cut edges only.
+            let nodes = self.tracker.cut_edge_ends(&semi.mesh);
+            let edges_of = |i| self.tracker.adjacency.edges_of(i);
+            step.gradient.compute_at(&semi.mesh, &ws.prim, &nodes, edges_of, &mut ws.grad);
         }
         self.wall_pressures(semi, &step, &ws.prim, &ws.grad)?;
         self.step = Some(step);

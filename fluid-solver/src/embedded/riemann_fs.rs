@@ -72,7 +72,7 @@ pub enum End {
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error(
     "wall flux at cut edge {edge} (nodes {i}-{j}), node {node} at {position:?}, surface triangle \
-     {triangle} of structure element {element}: {source}"
+     {triangle} of structure element {element}: {error}"
 )]
 pub struct WallFluxError {
     pub edge: u32,
@@ -82,7 +82,7 @@ pub struct WallFluxError {
     pub position: [f64; 3],
     pub triangle: u32,
     pub element: u32,
-    pub source: RiemannError,
+    pub error: RiemannError,
 }
 
 /// The flux of one end and its wall state.
@@ -140,7 +140,7 @@ pub fn one_sided(view: &WallFluxView, cut: &CutEdge, end: End) -> Result<OneSide
     let star = |w_in: &[f64; 5]| -> Result<Star, WallFluxError> {
         let u_n = w_in[1] * n_wall[0] + w_in[2] * n_wall[1] + w_in[3] * n_wall[2];
         let s = fluid_structure_with_cutoff(&mat.eos, w_in[0], u_n, w_in[4], w_n, mat.cutoff)
-            .map_err(|source| WallFluxError {
+            .map_err(|error| WallFluxError {
                 edge: cut.edge,
                 i,
                 j,
@@ -148,7 +148,7 @@ pub fn one_sided(view: &WallFluxView, cut: &CutEdge, end: End) -> Result<OneSide
                 position: mesh.coords[node as usize],
                 triangle: cut.triangle,
                 element: view.surface.element_of[cut.triangle as usize],
-                source,
+                error,
             })?;
         let dv = w_n - u_n;
         let (rho, p) = (s.state.rho, s.state.p);

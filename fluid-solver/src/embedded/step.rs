@@ -15,6 +15,7 @@ use crate::riemann::PressureCutoff;
 use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::special_edges::{SpecialEdge, SpecialEdges, SpecialKind};
 use interface_protocol::case::InterfaceTreatment;
+use rayon::prelude::*;
 
 /// The embedded boundary as one step's residuals read it.
 #[derive(Debug, Clone, PartialEq)]
@@ -277,19 +278,31 @@ impl Wall<'_> {
     ) -> Result<(Vec<WallPressures>, usize), WallFluxError> {
         let view = self.view(semi, prim, grad);
         let mesh = &semi.mesh;
-        let mut clips = 0;
-        let mut out = Vec::with_capacity(self.tracker.cuts.cuts.len());
-        for cut in &self.tracker.cuts.cuts {
-            let [i, j] = mesh.edges[cut.edge as usize].map(|v| v as usize);
-            let mut ps = [f64::NAN; 2];
-            for (k, (end, node)) in [(End::I, i), (End::J, j)].into_iter().enumerate() {
-                if self.tracker.active[node] {
-                    let s = one_sided(&view, cut, end)?;
-                    ps[k] = s.p;
-                    clips += s.clipped as usize;
+        // Each cut edge on its own, in parallel; the first failing edge (in edge order) is named.
+        let per_edge: Vec<Result<(WallPressures, usize), WallFluxError>> = self
+            .tracker
+            .cuts
+            .cuts
+            .par_iter()
+            .map(|cut| {
+                let [i, j] = mesh.edges[cut.edge as usize].map(|v| v as usize);
+                let (mut ps, mut clips) = ([f64::NAN; 2], 0);
+                for (k, (end, node)) in [(End::I, i), (End::J, j)].into_iter().enumerate() {
+                    if self.tracker.active[node] {
+                        let s = one_sided(&view, cut, end)?;
+                        ps[k] = s.p;
+                        clips += s.clipped as usize;
+                    }
                 }
-            }
+                Ok((ps, clips))
+            })
+            .collect();
+        let mut clips = 0;
+        let mut out = Vec::with_capacity(per_edge.len());
+        for r in per_edge {
+            let (ps, c) = r?;
             out.push(ps);
+            clips += c;
         }
         Ok((out, clips))
     }

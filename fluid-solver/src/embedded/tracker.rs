@@ -151,6 +151,21 @@ impl Tracker {
         changes
     }
 
+    /// The active end nodes of the cut edges, ascending, each once (the nodes whose states and
+    /// gradients the wall pressures read).
+    pub fn cut_edge_ends(&self, mesh: &Mesh) -> Vec<u32> {
+        let mut nodes: Vec<u32> = self
+            .cuts
+            .cuts
+            .iter()
+            .flat_map(|c| mesh.edges[c.edge as usize])
+            .filter(|&i| self.active[i as usize])
+            .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+    }
+
     /// Thesis §4.4: the largest distance a surface node moved over the step, in fluid edge
     /// lengths near it (keep it `<= 1`).
     pub fn step_ratio(&self, mesh: &Mesh) -> f64 {

@@ -227,6 +227,38 @@ fn add_edge_moment(m: &mut [[f64; 3]; 3], mesh: &Mesh, [i, j]: [u32; 2]) {
     }
 }
 
+/// The least-squares term of edge `i -> j` (added to both ends): `w d (u_j - u_i)` for each
+/// component, `d = x_j - x_i`, `w = 1/|d|²`.
+#[inline(always)]
+fn edge_term<const N: usize>(
+    mesh: &Mesh,
+    values: &[[f64; N]],
+    i: usize,
+    j: usize,
+) -> [[f64; 3]; N] {
+    let d = sub(mesh.coords[j], mesh.coords[i]);
+    let w = 1.0 / dot(d, d);
+    let wd = scale(d, w);
+    let (ui, uj) = (&values[i], &values[j]);
+    std::array::from_fn(|k| {
+        let du = uj[k] - ui[k];
+        [wd[0] * du, wd[1] * du, wd[2] * du]
+    })
+}
+
+/// `g_k <- M⁻¹ g_k` for every component, `M⁻¹` packed as by [`packed_inverse`].
+#[inline(always)]
+fn apply_inverse<const N: usize>(m: &[f64; 6], g: &mut [[f64; 3]; N]) {
+    for gk in g.iter_mut() {
+        let v = *gk;
+        *gk = [
+            m[0] * v[0] + m[1] * v[1] + m[2] * v[2],
+            m[1] * v[0] + m[3] * v[1] + m[4] * v[2],
+            m[2] * v[0] + m[4] * v[1] + m[5] * v[2],
+        ];
+    }
+}
+
 /// `M⁻¹` as `[xx, xy, xz, yy, yz, zz]`, zero where `M` is singular.
 fn packed_inverse(m: &[[f64; 3]; 3]) -> [f64; 6] {
     invert_sym3(m).map_or([0.0; 6], |v| [v[0][0], v[0][1], v[0][2], v[1][1], v[1][2], v[2][2]])
@@ -335,15 +367,7 @@ impl LsqGradient {
                 }
                 let [i, j] = mesh.edges[e];
                 let (i, j) = (i as usize, j as usize);
-                let d = sub(mesh.coords[j], mesh.coords[i]);
-                let w = 1.0 / dot(d, d);
-                let wd = scale(d, w);
-                let (ui, uj) = (&values[i], &values[j]);
-                let mut t = [[0.0; 3]; N];
-                for k in 0..N {
-                    let du = uj[k] - ui[k];
-                    t[k] = [wd[0] * du, wd[1] * du, wd[2] * du];
-                }
+                let t = edge_term(mesh, values, i, j);
                 for k in 0..N {
                     for a in 0..3 {
                         g[i][k][a] += t[k][a];
@@ -356,15 +380,7 @@ impl LsqGradient {
                 }
             }
             for i in blocks.completed(b) {
-                let m = &self.inverses[i];
-                for gk in g[i].iter_mut() {
-                    let v = *gk;
-                    *gk = [
-                        m[0] * v[0] + m[1] * v[1] + m[2] * v[2],
-                        m[1] * v[0] + m[3] * v[1] + m[4] * v[2],
-                        m[2] * v[0] + m[4] * v[1] + m[5] * v[2],
-                    ];
-                }
+                apply_inverse(&self.inverses[i], &mut g[i]);
             }
             let done = blocks.completed(b);
             for e in self.planes.entries(&done) {
@@ -373,6 +389,47 @@ impl LsqGradient {
             Ok::<(), std::convert::Infallible>(())
         });
         let Ok(()) = result;
+    }
+
+    /// [`LsqGradient::compute`] at the nodes `nodes` only (the other entries of `grad` are left
+    /// as they are), from each node's edges `edges_of(i)` (ascending, every edge of `i`): bitwise
+    /// the full pass's gradients there, the same terms summed in the same (edge) order. For the
+    /// few nodes a step reads outside its stages (the ends of cut edges).
+    pub fn compute_at<'a, const N: usize>(
+        &self,
+        mesh: &Mesh,
+        values: &[[f64; N]],
+        nodes: &[u32],
+        edges_of: impl Fn(usize) -> &'a [u32] + Sync,
+        grad: &mut [[[f64; 3]; N]],
+    ) {
+        let at: Vec<[[f64; 3]; N]> = nodes
+            .par_iter()
+            .map(|&i| {
+                let i = i as usize;
+                let mut g = [[0.0; 3]; N];
+                for &e in edges_of(i) {
+                    if !self.uses(e as usize) {
+                        continue;
+                    }
+                    let [a, b] = mesh.edges[e as usize].map(|v| v as usize);
+                    let t = edge_term(mesh, values, a, b);
+                    for k in 0..N {
+                        for c in 0..3 {
+                            g[k][c] += t[k][c];
+                        }
+                    }
+                }
+                apply_inverse(&self.inverses[i], &mut g);
+                for n in self.planes.of_node(i) {
+                    mirror_gradient(&mut g, n);
+                }
+                g
+            })
+            .collect();
+        for (&i, g) in nodes.iter().zip(at) {
+            grad[i as usize] = g;
+        }
     }
 
     /// Memory in bytes.
@@ -505,6 +562,30 @@ mod tests {
             }
         }
         assert!(on_one > 20 && on_both >= 6, "{on_one} nodes on one plane, {on_both} on both");
+    }
+
+    #[test]
+    fn gradients_at_some_nodes_are_the_full_pass_bitwise() {
+        let mesh = Mesh::build(perturbed_box([5, 4, 4])).unwrap();
+        let planes = MirrorPlanes::new(&mesh, &[face(&mesh, "zmin"), face(&mesh, "ymin")]);
+        let mask: Vec<bool> = (0..mesh.n_edges()).map(|e| e % 3 != 1).collect();
+        let lsq = LsqGradient::with_planes(&mesh, Some(&mask), planes);
+        let values: Vec<[f64; 5]> = mesh.coords.iter().map(|&x| wavy(x)).collect();
+        let mut full = vec![[[0.0; 3]; 5]; mesh.n_nodes()];
+        lsq.compute(&mesh, &values, &mut full);
+        let mut edges_of = vec![vec![]; mesh.n_nodes()];
+        for (e, &[i, j]) in mesh.edges.iter().enumerate() {
+            edges_of[i as usize].push(e as u32);
+            edges_of[j as usize].push(e as u32);
+        }
+        let nodes: Vec<u32> = (0..mesh.n_nodes() as u32).filter(|i| i % 4 == 0).collect();
+        let mut some = vec![[[7.0; 3]; 5]; mesh.n_nodes()];
+        lsq.compute_at(&mesh, &values, &nodes, |i| &edges_of[i], &mut some);
+        for i in 0..mesh.n_nodes() {
+            let expected = if i % 4 == 0 { full[i] } else { [[7.0; 3]; 5] };
+            assert_eq!(some[i], expected, "node {i}");
+        }
+        assert!(nodes.iter().any(|&i| !lsq.planes().of_node(i as usize).is_empty()));
     }
 
     #[test]

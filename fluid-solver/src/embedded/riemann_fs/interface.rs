@@ -21,7 +21,11 @@
 //! midpoint to `O(h²)`, so the facet flux is second order wherever the wall is. A uniform state
 //! that satisfies the wall condition (`u·n = w·n`) has zero gradient and `W*_Γ = W_i`: every state
 //! above is `W_i` and the flux is the physical flux, to round-off. A reconstructed state outside its
-//! EOS's domain falls back on the node state (1, 4) or on `W*_Γ` (3). Tait fluids take `p = p(ρ)`.
+//! EOS's domain falls back on the node state (1, 4) or on `W*_Γ` (3), and a `W_Γ` from which the
+//! wall recedes faster than its escape speed `2c/(γ-1)` (a steep expansion next to a fast wall,
+//! where the unlimited reconstruction nears vacuum) on the node's own wall state `W*(W_i)` of the
+//! thesis' form (2): a vacuum is an error only if the node state itself opens one. Tait fluids take
+//! `p = p(ρ)`.
 
 use super::{End, Star, WallFluxError, PARALLEL_TOLERANCE};
 use crate::embedded::CutEdge;
@@ -29,6 +33,7 @@ use crate::eos::Eos;
 use crate::mesh::geometry::{dot, norm, sub};
 use crate::reconstruct::limiter::Limiter;
 use crate::reconstruct::muscl::admissible;
+use crate::riemann::RiemannError;
 
 /// The fraction `α ∈ [0, 1]` of the edge from `x_node` (along `towards`, the edge vector from
 /// the node to the other end) at which the wall plane through `x_wall` with the normal `n_wall`
@@ -69,8 +74,12 @@ pub fn facet_states(
     let gd: [f64; 5] = std::array::from_fn(|k| dot(grad[k], towards));
     // Step 1: the node state at the intersection point.
     let at_wall = valid_or(eos, std::array::from_fn(|k| wi[k] + alpha * gd[k]), wi);
-    // Step 2: the wall state there.
-    let s = star(&at_wall)?;
+    // Step 2: the wall state there; if the reconstructed state separates from the wall (its
+    // escape speed is below the wall's recession, while the node's own is not), the thesis' form.
+    let s = match star(&at_wall) {
+        Err(e) if matches!(e.error, RiemannError::Vacuum { .. }) && at_wall != *wi => star(wi)?,
+        s => s?,
+    };
     // Step 3: the wall side of the facet, on the line through the star state.
     let w_f: [f64; 5] = if alpha >= 0.5 {
         let r = 0.5 / alpha;
