@@ -29,6 +29,7 @@ use crate::embedded::motion::RigidMotion;
 use crate::embedded::riemann_fs::{add_wall_fluxes, WallFluxView, WallMaterial};
 use crate::embedded::status::swept_nodes_among;
 use crate::embedded::step::EmbeddedStep;
+use crate::embedded::swept::Swept;
 use crate::embedded::tracker::{Seed, Tracker};
 use crate::embedded::Surface;
 use crate::eos::Eos;
@@ -316,17 +317,8 @@ fn track(
         let changes = parts.move_sides(mesh, cuts, &swept, &near);
         stamp("update_sides", &mut lap);
         let cut = parts.cuts.cut_mask(mesh.n_edges());
-        let filled = fill_changed(
-            mesh,
-            &parts.adjacency,
-            &changes,
-            &parts.sides,
-            &was_active,
-            &cut,
-            &ws.prim,
-            |_, _| true,
-            true,
-        )?;
+        let moved = Swept::new(mesh, &parts.adjacency, &changes, &parts.sides, &was_active, &cut);
+        let filled = fill_changed(&moved, &ws.prim, |_, _| true, true)?;
         std::hint::black_box(filled);
         stamp("fill", &mut lap);
         parts_step.update(semi, &parts);

@@ -22,6 +22,7 @@ use super::motion::RigidMotion;
 use super::side_fluid::{side_materials, side_phi};
 use super::step::{EmbeddedStep, Gradients, Wall};
 use super::surface::HermitePath;
+use super::swept::Swept;
 use super::tracker::Tracker;
 use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::mesh::geometry::{cross, norm};
@@ -204,29 +205,12 @@ impl EmbeddedRun {
         let changes = tracker.advance(&semi.mesh, t_b, &x, &v)?;
         let cut = tracker.cuts.cut_mask(semi.mesh.n_edges());
         let sides = &tracker.sides;
-        let changed_fluid = side_materials(
-            &semi.mesh,
-            &tracker.adjacency,
-            &changes,
-            sides,
-            &was_active,
-            &cut,
-            semi.material(),
-        );
+        let swept = Swept::new(&semi.mesh, &tracker.adjacency, &changes, sides, &was_active, &cut);
+        let changed_fluid = side_materials(&swept, semi.material());
+        // The swept nodes' fluids, level set and states, from their sources before the step.
+        let material = changed_fluid.as_deref().unwrap_or(semi.material());
         if let Some(ls) = &level_set {
-            let material = changed_fluid.as_deref().unwrap_or(semi.material());
-            let adjacency = &tracker.adjacency;
-            let phi = side_phi(
-                &semi.mesh,
-                adjacency,
-                &changes,
-                sides,
-                &was_active,
-                &cut,
-                material,
-                &state.phi,
-            );
-            for (i, p) in phi {
+            for (i, p) in side_phi(&swept, material, &state.phi) {
                 state.phi[i] = p;
             }
             debug_assert!(ls
@@ -234,6 +218,12 @@ impl EmbeddedRun {
                 .check(&State { material: material.to_vec(), ..state.clone() })
                 .is_ok());
         }
+        let filled = fill_changed(
+            &swept,
+            &ws.prim,
+            |i, j| material[i] == material[j],
+            self.interface == InterfaceTreatment::SecondOrder && semi.numerics.second_order(),
+        )?;
         if let Some(material) = changed_fluid {
             semi.set_materials(material.clone())?;
             let before = std::mem::replace(&mut state.material, material);
@@ -241,18 +231,6 @@ impl EmbeddedRun {
             // Nodes that changed fluid change the mask of uncut edges too: a new view.
             self.step = None;
         }
-        let material = semi.material();
-        let filled = fill_changed(
-            &semi.mesh,
-            &tracker.adjacency,
-            &changes,
-            sides,
-            &was_active,
-            &cut,
-            &ws.prim,
-            |i, j| material[i] == material[j],
-            self.interface == InterfaceTreatment::SecondOrder && semi.numerics.second_order(),
-        )?;
         for (i, w) in filled {
             let i = i as usize;
             undo.filled.push((i, state.cons[i]));

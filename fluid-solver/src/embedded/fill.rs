@@ -15,8 +15,7 @@
 //! error at each uncovered node that the flow carries away, which makes the scheme first order;
 //! the linear fill's is `O(h²)`.
 
-use super::adjacency::NodeEdges;
-use super::status::{NodeSides, NodeStatus, SideChange};
+use super::swept::Swept;
 use crate::mesh::Mesh;
 
 /// A newly active node that no neighbour could fill, named.
@@ -28,38 +27,21 @@ pub struct FillError {
     pub side: u32,
 }
 
-/// The primitive states of the nodes of `changes` that are active now: `(node, [ρ, u, v, w, p])`,
-/// ascending. `was_active` is each node's status before the step, `cut` the new per-edge cut
-/// mask, `prim` the states before the step, `same_fluid(i, j)` whether two nodes hold one fluid.
+/// The primitive states of the swept nodes that are active now: `(node, [ρ, u, v, w, p])`, in
+/// the order of the changes. `prim` holds the states before the step, `same_fluid(i, j)` whether
+/// two nodes hold one fluid.
 pub fn fill_changed(
-    mesh: &Mesh,
-    adjacency: &NodeEdges,
-    changes: &[SideChange],
-    sides: &NodeSides,
-    was_active: &[bool],
-    cut: &[bool],
+    swept: &Swept,
     prim: &[[f64; 5]],
     same_fluid: impl Fn(usize, usize) -> bool,
     linear: bool,
 ) -> Result<Vec<(u32, [f64; 5])>, FillError> {
-    let n = mesh.n_nodes();
-    let wanted: Vec<u32> =
-        changes.iter().filter(|c| c.new_status == NodeStatus::Active).map(|c| c.node).collect();
-    // A source keeps its state through the step: active before and after, on the same side.
-    let mut changed = vec![false; n];
-    for c in changes {
-        changed[c.node as usize] = true;
-    }
-    let is_source =
-        |j: usize| was_active[j] && !changed[j] && sides.status[j] == NodeStatus::Active;
-    let mut filled: Vec<Option<[f64; 5]>> = vec![None; wanted.len()];
+    let mesh = swept.mesh;
+    // The same-side, same-fluid neighbours of `i` that `ring` gives a state for, averaged.
     let average = |i: usize, ring: &dyn Fn(usize) -> Option<[f64; 5]>| -> Option<[f64; 5]> {
         let mut sum = [0.0; 5];
         let mut count = 0usize;
-        for (j, e) in adjacency.neighbours(mesh, i) {
-            if cut[e as usize] || sides.side[j] != sides.side[i] || !same_fluid(i, j) {
-                continue;
-            }
+        for j in swept.same_side(i).filter(|&j| same_fluid(i, j)) {
             if let Some(w) = ring(j) {
                 for c in 0..5 {
                     sum[c] += w[c];
@@ -71,46 +53,38 @@ pub fn fill_changed(
     };
     // The source `j`'s state at node `i`: carried along its gradient over its own sources.
     let carried = |j: usize, i: usize| -> [f64; 5] {
-        let stencil = adjacency.neighbours(mesh, j).filter(|&(m, e)| {
-            !cut[e as usize] && sides.side[m] == sides.side[j] && same_fluid(j, m) && is_source(m)
-        });
+        let stencil = swept.sources(j).filter(|&m| same_fluid(j, m));
         linear_at(mesh, prim, j, stencil, mesh.coords[i]).unwrap_or(prim[j])
     };
-    // Second ring for the rest: sources two edges away through uncut same-side edges.
-    for (k, &i) in wanted.iter().enumerate() {
-        let i = i as usize;
-        filled[k] =
-            average(i, &|j| is_source(j).then(|| if linear { carried(j, i) } else { prim[j] }));
-        if filled[k].is_some() {
-            continue;
-        }
-        let ring2 = |j: usize| average(j, &|m: usize| (m != i && is_source(m)).then(|| prim[m]));
-        filled[k] = average(i, &ring2);
-        if filled[k].is_none() {
-            return Err(FillError {
-                node: i as u32,
-                position: mesh.coords[i],
-                side: sides.side[i],
-            });
-        }
-    }
-    Ok(wanted.into_iter().zip(filled).map(|(i, w)| (i, w.expect("filled above"))).collect())
+    swept
+        .nodes()
+        .map(|i| {
+            let first =
+                |j: usize| swept.keeps(j).then(|| if linear { carried(j, i) } else { prim[j] });
+            // Second ring for the rest: sources two edges away.
+            let second =
+                |j: usize| average(j, &|m: usize| (m != i && swept.keeps(m)).then(|| prim[m]));
+            average(i, &first).or_else(|| average(i, &second)).map(|w| (i as u32, w)).ok_or(
+                FillError { node: i as u32, position: mesh.coords[i], side: swept.sides.side[i] },
+            )
+        })
+        .collect()
 }
 
 /// `W_j + G_j (x - x_j)` with `G_j` the least-squares gradient of `prim` at `j` over the nodes
-/// of `stencil` (`(node, edge)` pairs), each increment limited to three times the stencil's
+/// of `stencil`, each increment limited to three times the stencil's
 /// largest difference; `None` if the stencil does not span space or the result has `ρ <= 0` or `p <= 0`.
 fn linear_at(
     mesh: &Mesh,
     prim: &[[f64; 5]],
     j: usize,
-    stencil: impl Iterator<Item = (usize, u32)>,
+    stencil: impl Iterator<Item = usize>,
     x: [f64; 3],
 ) -> Option<[f64; 5]> {
     let xj = mesh.coords[j];
     let (mut m, mut b, mut range) = ([[0.0; 3]; 3], [[0.0; 3]; 5], [0.0f64; 5]);
     let mut scale = 0.0f64;
-    for (n, _) in stencil {
+    for n in stencil {
         let d: [f64; 3] = std::array::from_fn(|a| mesh.coords[n][a] - xj[a]);
         for a in 0..3 {
             for c in 0..3 {
@@ -154,6 +128,7 @@ fn inverse3(m: [[f64; 3]; 3], scale: f64) -> Option<[[f64; 3]; 3]> {
 mod tests {
     use super::*;
     use crate::embedded::generate::plate;
+    use crate::embedded::status::NodeStatus;
     use crate::embedded::tracker::{Seed, Tracker};
     use crate::embedded::Surface;
     use crate::mesh::boxmesh::{BoxCells, BoxSpec};
@@ -189,12 +164,7 @@ mod tests {
         );
         let cut = tracker.cuts.cut_mask(mesh.n_edges());
         let filled = fill_changed(
-            &mesh,
-            &tracker.adjacency,
-            &changes,
-            &tracker.sides,
-            &was_active,
-            &cut,
+            &Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut),
             &prim,
             |_, _| true,
             false,
@@ -210,12 +180,7 @@ mod tests {
             .collect();
         for linear in [false, true] {
             let filled = fill_changed(
-                &mesh,
-                &tracker.adjacency,
-                &changes,
-                &tracker.sides,
-                &was_active,
-                &cut,
+                &Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut),
                 &prim,
                 |_, _| true,
                 linear,
@@ -241,12 +206,7 @@ mod tests {
         let changes = tracker.advance(&mesh, 0.4, &s2.x, &v).unwrap();
         let cut = tracker.cuts.cut_mask(mesh.n_edges());
         let e = fill_changed(
-            &mesh,
-            &tracker.adjacency,
-            &changes,
-            &tracker.sides,
-            &was_active,
-            &cut,
+            &Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut),
             &prim,
             |_, _| true,
             true,

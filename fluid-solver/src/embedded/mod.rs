@@ -29,6 +29,7 @@ pub mod side_fluid;
 pub mod status;
 pub mod step;
 pub mod surface;
+pub mod swept;
 #[cfg(test)]
 pub(crate) mod test_cuts;
 #[cfg(test)]

@@ -9,68 +9,11 @@
 //! node with no source keeps its material (the fill then looks two edges away, or fails naming
 //! the node).
 
-use super::adjacency::NodeEdges;
-use super::status::{NodeSides, NodeStatus, SideChange};
-use crate::mesh::Mesh;
+use super::swept::Swept;
 use crate::state::MaterialId;
 
-/// The nodes that changed side in a step and are active now, and the sources of each: its
-/// neighbours through an edge the surface does not cut now, on the same side, active before and
-/// after the step and not changed in it (module docs).
-struct Swept<'a> {
-    mesh: &'a Mesh,
-    adjacency: &'a NodeEdges,
-    changes: &'a [SideChange],
-    sides: &'a NodeSides,
-    was_active: &'a [bool],
-    cut: &'a [bool],
-    changed: std::collections::HashSet<u32>,
-}
-
-impl<'a> Swept<'a> {
-    fn new(
-        mesh: &'a Mesh,
-        adjacency: &'a NodeEdges,
-        changes: &'a [SideChange],
-        sides: &'a NodeSides,
-        was_active: &'a [bool],
-        cut: &'a [bool],
-    ) -> Swept<'a> {
-        let changed = changes.iter().map(|c| c.node).collect();
-        Swept { mesh, adjacency, changes, sides, was_active, cut, changed }
-    }
-
-    /// The swept nodes that are active now.
-    fn nodes(&self) -> impl Iterator<Item = usize> + '_ {
-        self.changes.iter().filter(|c| c.new_status == NodeStatus::Active).map(|c| c.node as usize)
-    }
-
-    /// The sources of node `i`.
-    fn sources(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        let sides = self.sides;
-        self.adjacency.neighbours(self.mesh, i).filter_map(move |(j, e)| {
-            let source = self.was_active[j]
-                && !self.changed.contains(&(j as u32))
-                && sides.status[j] == NodeStatus::Active
-                && sides.side[j] == sides.side[i]
-                && !self.cut[e as usize];
-            source.then_some(j)
-        })
-    }
-}
-
 /// The material layout after the changes of a step, or `None` when no node changes fluid.
-/// `was_active` is each node's status before the step, `cut` the new per-edge cut mask.
-pub fn side_materials(
-    mesh: &Mesh,
-    adjacency: &NodeEdges,
-    changes: &[SideChange],
-    sides: &NodeSides,
-    was_active: &[bool],
-    cut: &[bool],
-    material: &[MaterialId],
-) -> Option<Vec<MaterialId>> {
-    let swept = Swept::new(mesh, adjacency, changes, sides, was_active, cut);
+pub fn side_materials(swept: &Swept, material: &[MaterialId]) -> Option<Vec<MaterialId>> {
     let mut out: Option<Vec<MaterialId>> = None;
     for i in swept.nodes() {
         let mut count = [0u32; 256];
@@ -93,17 +36,7 @@ pub fn side_materials(
 /// together): the mean `φ` of their sources that hold their new material `material[i]` (from
 /// [`side_materials`]), so the sign of `φ` gives that material; a node with no such source keeps
 /// its `φ` (and, having no source at all, its material). `(node, φ)`, ascending by change.
-pub fn side_phi(
-    mesh: &Mesh,
-    adjacency: &NodeEdges,
-    changes: &[SideChange],
-    sides: &NodeSides,
-    was_active: &[bool],
-    cut: &[bool],
-    material: &[MaterialId],
-    phi: &[f64],
-) -> Vec<(usize, f64)> {
-    let swept = Swept::new(mesh, adjacency, changes, sides, was_active, cut);
+pub fn side_phi(swept: &Swept, material: &[MaterialId], phi: &[f64]) -> Vec<(usize, f64)> {
     swept
         .nodes()
         .filter_map(|i| {
@@ -123,6 +56,7 @@ mod tests {
     use crate::embedded::tracker::{Seed, Tracker};
     use crate::embedded::Surface;
     use crate::mesh::boxmesh::{BoxCells, BoxSpec};
+    use crate::mesh::Mesh;
     use interface_protocol::case::Tracking;
 
     /// A shell with fluid 1 left of it and fluid 0 right moves 0.6 cells to the right: the nodes
@@ -144,37 +78,24 @@ mod tests {
         let v = vec![[1.0, 0.0, 0.0]; s1.x.len()];
         let changes = tracker.advance(&mesh, 0.06, &s1.x, &v).unwrap();
         let cut = tracker.cuts.cut_mask(mesh.n_edges());
-        let new = side_materials(
-            &mesh,
-            &tracker.adjacency,
-            &changes,
-            &tracker.sides,
-            &was_active,
-            &cut,
-            &material,
-        )
-        .expect("the swept nodes change fluid");
-        let swept: Vec<usize> = (0..mesh.n_nodes()).filter(|&i| new[i] != material[i]).collect();
-        assert!(!swept.is_empty());
+        let swept =
+            Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut);
+        let new = side_materials(&swept, &material).expect("the swept nodes change fluid");
+        let passed: Vec<usize> = (0..mesh.n_nodes()).filter(|&i| new[i] != material[i]).collect();
+        assert!(!passed.is_empty());
         for i in 0..mesh.n_nodes() {
             let x = mesh.coords[i][0];
             let expected = if x < 0.61 { 1 } else { 0 };
             assert_eq!(new[i], expected, "node {i} at x = {x}");
         }
-        assert!(swept.iter().all(|&i| (mesh.coords[i][0] - 0.6).abs() < 1e-12), "{swept:?}");
+        assert!(passed.iter().all(|&i| (mesh.coords[i][0] - 0.6).abs() < 1e-12), "{passed:?}");
         // Nothing moves: no change of fluid.
         let was_active = tracker.active.clone();
         let changes = tracker.advance(&mesh, 0.07, &s1.x, &vec![[0.0; 3]; s1.x.len()]).unwrap();
         let cut = tracker.cuts.cut_mask(mesh.n_edges());
-        let same = side_materials(
-            &mesh,
-            &tracker.adjacency,
-            &changes,
-            &tracker.sides,
-            &was_active,
-            &cut,
-            &new,
-        );
+        let swept =
+            Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut);
+        let same = side_materials(&swept, &new);
         assert_eq!(same, None);
     }
 }
