@@ -6,6 +6,8 @@
 //! with h5py; and the wet surface of a tet cube (`couple::wet_surface`): its boundary
 //! triangles, area and outward normals.
 
+mod common;
+
 use std::process::Command;
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -196,13 +198,8 @@ point = [1.0, 0.0, 0.0]
 [output]
 fields_every = 100
 "#;
-    let path = dir.path().join("case.toml");
-    std::fs::write(&path, case).unwrap();
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_structure-solver"))
-        .args(["run", path.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()])
-        .output()
-        .unwrap();
+    let o = common::cli::run_in(dir.path(), case);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let xdmf = std::fs::read_to_string(out.join("structure.xdmf")).unwrap();
     assert!(xdmf.contains("von_mises"), "structure.xdmf has no von_mises field");

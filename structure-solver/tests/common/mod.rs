@@ -1,6 +1,8 @@
 //! Shared helpers of the structure tests: load-deflection tables against published references.
 #![allow(dead_code)]
 
+pub mod cli;
+
 use structure_solver::model::Model;
 use structure_solver::statics::{load_steps, NewtonSettings};
 
