@@ -13,6 +13,8 @@
 //! and Keller-Miksis tending to Rayleigh-Plesset as `1/c`.
 
 mod common;
+#[path = "underwater_bubble/gas_volume.rs"]
+mod gas_volume;
 #[path = "underwater_bubble/keller_miksis.rs"]
 mod keller_miksis;
 #[path = "underwater_bubble/picture.rs"]
@@ -118,36 +120,29 @@ fn test_mesh() -> (usize, f64) {
 }
 
 /// The case folder's domain size (its `fluid.mesh.box.hi`).
-const DOMAIN: f64 = 0.3207;
+const CASE_DOMAIN: f64 = 0.3207;
+
+/// The domain's size: the case's, or `BUBBLE_DOMAIN=<m>`.
+fn domain() -> f64 {
+    std::env::var("BUBBLE_DOMAIN").map_or(CASE_DOMAIN, |s| s.parse().expect("domain size in m"))
+}
 
 /// The grading of `cells` cells growing from `h0` to fill [`DOMAIN`]: the root of
 /// `h0 (r^n - 1)/(r - 1) = DOMAIN`, by bisection.
 fn grading(cells: usize, h0: f64) -> f64 {
+    let domain = domain();
     let length = |r: f64| h0 * (r.powi(cells as i32) - 1.0) / (r - 1.0);
-    assert!(length(1.0 + 1e-9) < DOMAIN, "{cells} cells of {h0} m cannot grow to fill the domain");
+    assert!(length(1.0 + 1e-9) < domain, "{cells} cells of {h0} m cannot grow to fill the domain");
     let (mut lo, mut hi) = (1.0 + 1e-9, 2.0);
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
-        if length(mid) < DOMAIN {
+        if length(mid) < domain {
             lo = mid;
         } else {
             hi = mid;
         }
     }
     0.5 * (lo + hi)
-}
-
-/// The gas volume the level set holds in the octant: `Σ |C_i| H(φ_i/h_i)` with the linear
-/// ramp `H(s) = clamp(1/2 + s, 0, 1)` across each node's dual cell, whose size `h_i` is the cube
-/// root of its volume mirrored through the symmetry planes it lies on.
-fn gas_volume(coords: &[[f64; 3]], volumes: &[f64], phi: &[f64]) -> f64 {
-    let mut v = 0.0;
-    for i in 0..coords.len() {
-        let mirrored = coords[i].iter().filter(|&&x| x.abs() < 1e-12).count();
-        let h = (volumes[i] * f64::from(1u32 << mirrored)).cbrt();
-        v += volumes[i] * (0.5 + phi[i] / h).clamp(0.0, 1.0);
-    }
-    v
 }
 
 /// The radius of a sphere whose octant holds `v`.
@@ -165,21 +160,47 @@ struct BubbleRun {
     seconds: f64,
 }
 
+/// The case with `overrides`, run to `t_end`, and its text.
+fn load(overrides: &[String], t_end: f64) -> (Case, String) {
+    let mut all = overrides.to_vec();
+    all.push(format!("fluid.time.t_end={t_end:e}"));
+    (Case::load(&case_path(), &all).unwrap(), std::fs::read_to_string(case_path()).unwrap())
+}
+
+/// The run of `case` writing into `out`.
+fn open<'a>(case: &'a Case, text: &'a str, out: &Path) -> FluidRun<'a> {
+    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: true };
+    FluidRun::open(case, text, &opts, Mode::Alone).unwrap()
+}
+
+/// The mesh overrides of `cells` graded cells per axis from a centre cell `h0`.
+fn mesh_overrides(cells: usize, h0: f64) -> Vec<String> {
+    let r = grading(cells, h0);
+    vec![
+        format!("fluid.mesh.box.cells=[{cells},{cells},{cells}]"),
+        format!("fluid.mesh.box.grading=[{r},{r},{r}]"),
+        format!("fluid.mesh.box.hi=[{d},{d},{d}]", d = domain()),
+    ]
+}
+
 /// Runs the case with `overrides` to `t_end` into `out`, sampling the equivalent radius every
 /// `every` seconds into `out/radius.csv`.
 fn run(overrides: &[String], t_end: f64, every: f64, out: &Path) -> BubbleRun {
     let start = std::time::Instant::now();
-    let mut all = overrides.to_vec();
-    all.push(format!("fluid.time.t_end={t_end:e}"));
-    let case = Case::load(&case_path(), &all).unwrap();
-    let text = std::fs::read_to_string(case_path()).unwrap();
-    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: true };
-    let mut run = FluidRun::open(&case, &text, &opts, Mode::Alone).unwrap();
-    let mesh = &run.semidiscretization().mesh;
-    let (coords, volumes) = (mesh.coords.clone(), mesh.volumes.clone());
+    let (case, text) = load(overrides, t_end);
+    let mut run = open(&case, &text, out);
+    let mesh = run.semidiscretization().mesh.clone();
+    let coords = mesh.coords.clone();
     let nodes = coords.len();
-    let radius_of =
-        |run: &FluidRun| equivalent_radius(gas_volume(&coords, &volumes, &run.state().phi));
+    let radius_of = |run: &FluidRun| {
+        equivalent_radius(gas_volume::piecewise_linear(&mesh, &run.state().phi).unwrap())
+    };
+    let r_dual = equivalent_radius(gas_volume::smoothed_heaviside(&mesh, &run.state().phi));
+    println!(
+        "R(0): piecewise-linear {:.5} R0, dual cells {:.5} R0",
+        radius_of(&run) / R0,
+        r_dual / R0
+    );
     let mut radius = vec![(0.0, radius_of(&run))];
     let samples = (t_end / every).round() as usize;
     for k in 1..=samples {
@@ -223,6 +244,41 @@ fn measured_cycle(s: &[(f64, f64)]) -> Cycle {
     Cycle { t_max, r_max, t_min, r_min }
 }
 
+/// The initial radius from the level set on graded meshes of centre cell `R0/4 ... R0/16`: the
+/// piecewise-linear volume ([`gas_volume::piecewise_linear`]) against the dual-cell ramp
+/// ([`gas_volume::smoothed_heaviside`]).
+#[test]
+fn initial_radius_from_the_level_set_converges_at_second_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut errors = Vec::new();
+    for (cells, n) in [(24, 4.0), (36, 8.0), (48, 16.0)] {
+        let h0 = R0 / n;
+        let (case, text) = load(&mesh_overrides(cells, h0), 1e-6);
+        let run = open(&case, &text, &dir.path().join(format!("r{n}")));
+        let mesh = &run.semidiscretization().mesh;
+        let phi = &run.state().phi;
+        let pl = equivalent_radius(gas_volume::piecewise_linear(mesh, phi).unwrap()) / R0 - 1.0;
+        let dual = equivalent_radius(gas_volume::smoothed_heaviside(mesh, phi)) / R0 - 1.0;
+        println!("R0/h0 = {n}: R(0) piecewise-linear {:+.3e}, dual cells {:+.3e}", pl, dual);
+        errors.push((n, pl, dual));
+    }
+    // Seen: -8.5e-3, -2.5e-3, -8.0e-4 (order 1.8 then 1.6; the interpolant's surface lies
+    // inside the convex sphere) against the dual cells' +2.4e-2, +6.9e-3, +3.9e-3 (order 0.8 at
+    // the finest pair: the O(h) bias).
+    assert!(errors[0].1.abs() < 0.01, "R0/h0 = 4: piecewise-linear R(0) error {}", errors[0].1);
+    for w in errors.windows(2) {
+        let order = |k: fn(&(f64, f64, f64)) -> f64| {
+            (k(&w[0]) / k(&w[1])).abs().ln() / (w[1].0 / w[0].0).ln()
+        };
+        let (pl, dual) = (order(|e| e.1), order(|e| e.2));
+        println!(
+            "R0/h0 {} -> {}: order piecewise-linear {pl:.2}, dual cells {dual:.2}",
+            w[0].0, w[1].0
+        );
+        assert!(pl > 1.5, "piecewise-linear R(0) order {pl} from R0/h0 = {}", w[0].0);
+    }
+}
+
 #[test]
 #[ignore = "not yet passing: R(0) from the level set is 1.024 R0 on the coarse mesh (the check asks 2%)"]
 fn bubble_follows_keller_miksis_to_its_first_minimum() {
@@ -242,14 +298,17 @@ fn bubble_follows_keller_miksis_to_its_first_minimum() {
         Ok(_) => Vec::new(),
         Err(_) => {
             let (cells, h0) = test_mesh();
-            let r = grading(cells, h0);
-            println!("mesh: {cells} cells per axis from {h0:e} m, grading {r:.5}");
-            vec![
-                format!("fluid.mesh.box.cells=[{cells},{cells},{cells}]"),
-                format!("fluid.mesh.box.grading=[{r},{r},{r}]"),
-            ]
+            println!(
+                "mesh: {cells} cells per axis from {h0:e} m, grading {:.5}",
+                grading(cells, h0)
+            );
+            mesh_overrides(cells, h0)
         }
     };
+    let mut overrides = overrides;
+    if let Ok(extra) = std::env::var("BUBBLE_SET") {
+        overrides.extend(extra.split(';').filter(|s| !s.is_empty()).map(String::from));
+    }
     let dir = tempfile::tempdir().unwrap();
     let out = std::env::var("BUBBLE_OUT").map_or_else(|_| dir.path().join("run"), PathBuf::from);
     // To 15% past the minimum (before the second maximum), the radius 150 times a cycle.
