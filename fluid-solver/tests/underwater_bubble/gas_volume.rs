@@ -50,6 +50,17 @@ fn tet_volume(x: [[f64; 3]; 4]) -> f64 {
 /// The volume where the piecewise-linear interpolant of the nodal `phi` is positive, over the
 /// mesh's tets and hexes (each hex as [`HEX_TETS`]).
 pub fn piecewise_linear(mesh: &Mesh, phi: &[f64]) -> anyhow::Result<f64> {
+    positive_integral(mesh, phi, None)
+}
+
+/// The integral of the nodal `f` over the same volume, `f` taken in each tet as the mean of its
+/// vertices where `φ > 0` (the gas mass from the gas density: free of the jumps of a sum over
+/// the gas nodes' dual cells as nodes change fluid).
+pub fn piecewise_linear_integral(mesh: &Mesh, phi: &[f64], f: &[f64]) -> anyhow::Result<f64> {
+    positive_integral(mesh, phi, Some(f))
+}
+
+fn positive_integral(mesh: &Mesh, phi: &[f64], f: Option<&[f64]>) -> anyhow::Result<f64> {
     let mut v = 0.0;
     for (n, cell) in mesh.cells.iter().enumerate() {
         let tets: &[[usize; 4]] = match cell.kind {
@@ -59,14 +70,16 @@ pub fn piecewise_linear(mesh: &Mesh, phi: &[f64]) -> anyhow::Result<f64> {
         };
         let nodes = cell.nodes();
         for t in tets {
-            let at = |k: usize| nodes[t[k]] as usize;
-            let values = [phi[at(0)], phi[at(1)], phi[at(2)], phi[at(3)]];
+            let at = t.map(|k| nodes[k] as usize);
+            let values = at.map(|i| phi[i]);
             if values.iter().all(|&p| p <= 0.0) {
                 continue;
             }
-            let x =
-                [mesh.coords[at(0)], mesh.coords[at(1)], mesh.coords[at(2)], mesh.coords[at(3)]];
-            v += tet_volume(x) * positive_fraction(values);
+            let weight = f.map_or(1.0, |f| {
+                let gas: Vec<f64> = at.iter().filter(|&&i| phi[i] > 0.0).map(|&i| f[i]).collect();
+                gas.iter().sum::<f64>() / gas.len() as f64
+            });
+            v += tet_volume(at.map(|i| mesh.coords[i])) * positive_fraction(values) * weight;
         }
     }
     Ok(v)
