@@ -1,18 +1,23 @@
 //! `cases/underwater-bubble`: a sphere of gas at 10 MPa in water at 1 MPa, on one octant with
 //! symmetry planes, against the Keller-Miksis equation ([`keller_miksis`]): the first maximum
-//! radius and the time of the first minimum, the radius the equivalent one of the gas volume the
-//! level set holds, `(3V/(4π/8))^(1/3)`, written to `radius.csv`.
+//! radius and the time of the first minimum, the radius the equivalent one `(3V/(4π/8))^(1/3)` of
+//! the volume where the piecewise-linear interpolant of the level set is positive
+//! ([`gas_volume::piecewise_linear`], `O(h²)`), written to `radius.csv` with the gas mass.
 //!
-//! The test runs the case on a coarse mesh (`R0/h = 4` at the centre, 24 graded cells per axis;
-//! `BUBBLE_CELLS=<n>` and `BUBBLE_H0=<m>` choose another, with the grading that keeps the
-//! domain's size). `BUBBLE_OUT=<dir>` keeps the run (its `radius.csv`) and
-//! `BUBBLE_PNG=<path>` the pressure picture; `BUBBLE_CASE_MESH=1` runs the case folder's own mesh
-//! (how its `pressure.png` is drawn).
+//! The comparison runs one mesh of the case's domain: by default the coarse `R0/h = 3` at the
+//! centre, 24 graded cells per axis; `BUBBLE_CELLS=<n>` and `BUBBLE_H0=<m>` choose another, with
+//! the grading that fills the domain (`BUBBLE_DOMAIN=<m>` another domain), and
+//! `BUBBLE_CASE_MESH=1` the case folder's own mesh. `BUBBLE_OUT=<dir>` keeps the run (its
+//! `radius.csv`), `BUBBLE_PNG=<path>` the pressure picture (the case folder's is drawn by
+//! `BUBBLE_CASE_MESH=1 BUBBLE_PNG=$PWD/cases/underwater-bubble/pressure.png`), and
+//! `BUBBLE_SET="key=value;..."` adds case overrides.
 //! The equation's own checks: Rayleigh's collapse time of an empty cavity, the Rayleigh-Plesset
 //! limit (`c = ∞`: its energy invariant, the maximum radius it fixes, the minimum back at `R0`),
 //! and Keller-Miksis tending to Rayleigh-Plesset as `1/c`.
 
 mod common;
+#[path = "underwater_bubble/gas_volume.rs"]
+mod gas_volume;
 #[path = "underwater_bubble/keller_miksis.rs"]
 mod keller_miksis;
 #[path = "underwater_bubble/picture.rs"]
@@ -113,41 +118,34 @@ fn keller_miksis_tends_to_rayleigh_plesset_as_one_over_c() {
 /// The coarse mesh of the test: `(cells per axis, centre cell h0)`.
 fn test_mesh() -> (usize, f64) {
     let cells = std::env::var("BUBBLE_CELLS").map_or(24, |s| s.parse().expect("cells per axis"));
-    let h0 = std::env::var("BUBBLE_H0").map_or(R0 / 4.0, |s| s.parse().expect("h0 in m"));
+    let h0 = std::env::var("BUBBLE_H0").map_or(R0 / 3.0, |s| s.parse().expect("h0 in m"));
     (cells, h0)
 }
 
 /// The case folder's domain size (its `fluid.mesh.box.hi`).
-const DOMAIN: f64 = 0.3207;
+const CASE_DOMAIN: f64 = 1.6;
+
+/// The domain's size: the case's, or `BUBBLE_DOMAIN=<m>`.
+fn domain() -> f64 {
+    std::env::var("BUBBLE_DOMAIN").map_or(CASE_DOMAIN, |s| s.parse().expect("domain size in m"))
+}
 
 /// The grading of `cells` cells growing from `h0` to fill [`DOMAIN`]: the root of
 /// `h0 (r^n - 1)/(r - 1) = DOMAIN`, by bisection.
 fn grading(cells: usize, h0: f64) -> f64 {
+    let domain = domain();
     let length = |r: f64| h0 * (r.powi(cells as i32) - 1.0) / (r - 1.0);
-    assert!(length(1.0 + 1e-9) < DOMAIN, "{cells} cells of {h0} m cannot grow to fill the domain");
+    assert!(length(1.0 + 1e-9) < domain, "{cells} cells of {h0} m cannot grow to fill the domain");
     let (mut lo, mut hi) = (1.0 + 1e-9, 2.0);
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
-        if length(mid) < DOMAIN {
+        if length(mid) < domain {
             lo = mid;
         } else {
             hi = mid;
         }
     }
     0.5 * (lo + hi)
-}
-
-/// The gas volume the level set holds in the octant: `Σ |C_i| H(φ_i/h_i)` with the linear
-/// ramp `H(s) = clamp(1/2 + s, 0, 1)` across each node's dual cell, whose size `h_i` is the cube
-/// root of its volume mirrored through the symmetry planes it lies on.
-fn gas_volume(coords: &[[f64; 3]], volumes: &[f64], phi: &[f64]) -> f64 {
-    let mut v = 0.0;
-    for i in 0..coords.len() {
-        let mirrored = coords[i].iter().filter(|&&x| x.abs() < 1e-12).count();
-        let h = (volumes[i] * f64::from(1u32 << mirrored)).cbrt();
-        v += volumes[i] * (0.5 + phi[i] / h).clamp(0.0, 1.0);
-    }
-    v
 }
 
 /// The radius of a sphere whose octant holds `v`.
@@ -165,28 +163,74 @@ struct BubbleRun {
     seconds: f64,
 }
 
+/// The case with `overrides`, run to `t_end`, and its text.
+fn load(overrides: &[String], t_end: f64) -> (Case, String) {
+    let mut all = overrides.to_vec();
+    all.push(format!("fluid.time.t_end={t_end:e}"));
+    (Case::load(&case_path(), &all).unwrap(), std::fs::read_to_string(case_path()).unwrap())
+}
+
+/// The run of `case` writing into `out`.
+fn open<'a>(case: &'a Case, text: &'a str, out: &Path) -> FluidRun<'a> {
+    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: true };
+    FluidRun::open(case, text, &opts, Mode::Alone).unwrap()
+}
+
+/// The mesh overrides of `cells` graded cells per axis from a centre cell `h0` filling
+/// [`domain`].
+fn mesh_overrides(cells: usize, h0: f64) -> Vec<String> {
+    graded_box(cells, grading(cells, h0), domain())
+}
+
+/// The mesh overrides of a box `[0, size]³` of `cells` cells per axis growing by `r`.
+fn graded_box(cells: usize, r: f64, size: f64) -> Vec<String> {
+    vec![
+        format!("fluid.mesh.box.cells=[{cells},{cells},{cells}]"),
+        format!("fluid.mesh.box.grading=[{r},{r},{r}]"),
+        format!("fluid.mesh.box.hi=[{size},{size},{size}]"),
+    ]
+}
+
 /// Runs the case with `overrides` to `t_end` into `out`, sampling the equivalent radius every
 /// `every` seconds into `out/radius.csv`.
 fn run(overrides: &[String], t_end: f64, every: f64, out: &Path) -> BubbleRun {
     let start = std::time::Instant::now();
-    let mut all = overrides.to_vec();
-    all.push(format!("fluid.time.t_end={t_end:e}"));
-    let case = Case::load(&case_path(), &all).unwrap();
-    let text = std::fs::read_to_string(case_path()).unwrap();
-    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: true };
-    let mut run = FluidRun::open(&case, &text, &opts, Mode::Alone).unwrap();
-    let mesh = &run.semidiscretization().mesh;
-    let (coords, volumes) = (mesh.coords.clone(), mesh.volumes.clone());
+    let (case, text) = load(overrides, t_end);
+    let mut run = open(&case, &text, out);
+    let mesh = run.semidiscretization().mesh.clone();
+    let coords = mesh.coords.clone();
     let nodes = coords.len();
-    let radius_of =
-        |run: &FluidRun| equivalent_radius(gas_volume(&coords, &volumes, &run.state().phi));
+    let radius_of = |run: &FluidRun| {
+        equivalent_radius(gas_volume::piecewise_linear(&mesh, &run.state().phi).unwrap())
+    };
+    let r_dual = equivalent_radius(gas_volume::smoothed_heaviside(&mesh, &run.state().phi));
+    println!(
+        "R(0): piecewise-linear {:.5} R0, dual cells {:.5} R0",
+        radius_of(&run) / R0,
+        r_dual / R0
+    );
+    // The gas mass, a diagnostic written beside the radius (the ghost-fluid method does not
+    // conserve it).
+    let gas_mass_of = |run: &FluidRun| {
+        let state = run.state();
+        let rho: Vec<f64> = state.cons.iter().map(|u| u[0]).collect();
+        gas_volume::piecewise_linear_integral(&mesh, &state.phi, &rho).unwrap()
+    };
     let mut radius = vec![(0.0, radius_of(&run))];
+    let mut gas_mass = vec![gas_mass_of(&run)];
     let samples = (t_end / every).round() as usize;
     for k in 1..=samples {
         let t = t_end * k as f64 / samples as f64;
         let reached = run.advance_to(t).unwrap();
         radius.push((reached.t, radius_of(&run)));
+        gas_mass.push(gas_mass_of(&run));
     }
+    let drift = gas_mass.iter().map(|m| (m / gas_mass[0] - 1.0).abs()).fold(0.0, f64::max);
+    println!(
+        "gas mass: largest drift {:.2}%, at the end {:+.2}%",
+        100.0 * drift,
+        100.0 * (gas_mass.last().unwrap() / gas_mass[0] - 1.0)
+    );
     let steps = run.reached().step;
     let eos = run.semidiscretization().eos.clone();
     run.finish().unwrap();
@@ -194,9 +238,9 @@ fn run(overrides: &[String], t_end: f64, every: f64, out: &Path) -> BubbleRun {
     let pressure = (0..nodes).map(|i| eos[end.material[i] as usize].cons_to_prim(&end.cons[i])[4]);
     let pressure = pressure.collect();
     let mut csv = std::fs::File::create(out.join("radius.csv")).unwrap();
-    writeln!(csv, "time,radius").unwrap();
-    for (t, r) in &radius {
-        writeln!(csv, "{t:e},{r:e}").unwrap();
+    writeln!(csv, "time,radius,gas_mass").unwrap();
+    for ((t, r), m) in radius.iter().zip(&gas_mass) {
+        writeln!(csv, "{t:e},{r:e},{m:e}").unwrap();
     }
     BubbleRun { radius, coords, pressure, nodes, steps, seconds: start.elapsed().as_secs_f64() }
 }
@@ -223,8 +267,48 @@ fn measured_cycle(s: &[(f64, f64)]) -> Cycle {
     Cycle { t_max, r_max, t_min, r_min }
 }
 
+/// The initial radius from the level set on graded meshes of centre cell `h0 = R0/n` growing by
+/// `1 + 1/(2n)` (so the cells at `R0` halve with `h0`), `2n` cells per axis (to `3.1-3.4 R0`), for
+/// `n = 4, 8, 16`: the piecewise-linear volume ([`gas_volume::piecewise_linear`]) against the
+/// dual-cell ramp ([`gas_volume::smoothed_heaviside`]).
 #[test]
-#[ignore = "not yet passing: R(0) from the level set is 1.024 R0 on the coarse mesh (the check asks 2%)"]
+fn initial_radius_from_the_level_set_converges_at_second_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut errors = Vec::new();
+    for n in [4.0, 8.0, 16.0] {
+        let (h0, r, cells) = (R0 / n, 1.0 + 0.5 / n, 2 * n as usize);
+        let size = h0 * (r.powi(cells as i32) - 1.0) / (r - 1.0);
+        let mut overrides = graded_box(cells, r, size);
+        overrides.extend(["fluid.lines=[]".into(), "fluid.probes=[]".into()]);
+        let (case, text) = load(&overrides, 1e-6);
+        let run = open(&case, &text, &dir.path().join(format!("r{n}")));
+        let mesh = &run.semidiscretization().mesh;
+        let phi = &run.state().phi;
+        let pl = equivalent_radius(gas_volume::piecewise_linear(mesh, phi).unwrap()) / R0 - 1.0;
+        let dual = equivalent_radius(gas_volume::smoothed_heaviside(mesh, phi)) / R0 - 1.0;
+        println!("R0/h0 = {n}: R(0) piecewise-linear {:+.3e}, dual cells {:+.3e}", pl, dual);
+        errors.push((n, pl, dual));
+    }
+    // Seen: -8.5e-3, -2.2e-3, -5.7e-4 (order 1.96, 1.95; the interpolant's surface lies inside
+    // the convex sphere) against the dual cells' +2.4e-2, +5.1e-3, +1.1e-3: second order too on
+    // this family, whose grading tends to 1 with h0 (the offset of a dual cell's centroid from its
+    // node, `(r - 1) h/4`, is then O(h²)), but 2.8 times larger on the coarse mesh.
+    assert!(errors[0].1.abs() < 0.01, "R0/h0 = 4: piecewise-linear R(0) error {}", errors[0].1);
+    for w in errors.windows(2) {
+        let order = |k: fn(&(f64, f64, f64)) -> f64| {
+            (k(&w[0]) / k(&w[1])).abs().ln() / (w[1].0 / w[0].0).ln()
+        };
+        let (pl, dual) = (order(|e| e.1), order(|e| e.2));
+        println!(
+            "R0/h0 {} -> {}: order piecewise-linear {pl:.2}, dual cells {dual:.2}",
+            w[0].0, w[1].0
+        );
+        assert!(pl > 1.8, "piecewise-linear R(0) order {pl} from R0/h0 = {}", w[0].0);
+    }
+}
+
+#[test]
+#[ignore = "not yet passing: R_max 21.6%, 17.2%, 12.5% below Keller-Miksis on R0/3, R0/4, R0/6, the gas losing about 20% of its mass; see the case README"]
 fn bubble_follows_keller_miksis_to_its_first_minimum() {
     let km = bubble(c_water()).first_cycle(1e-8);
     let rp = bubble(f64::INFINITY).first_cycle(1e-8);
@@ -242,14 +326,17 @@ fn bubble_follows_keller_miksis_to_its_first_minimum() {
         Ok(_) => Vec::new(),
         Err(_) => {
             let (cells, h0) = test_mesh();
-            let r = grading(cells, h0);
-            println!("mesh: {cells} cells per axis from {h0:e} m, grading {r:.5}");
-            vec![
-                format!("fluid.mesh.box.cells=[{cells},{cells},{cells}]"),
-                format!("fluid.mesh.box.grading=[{r},{r},{r}]"),
-            ]
+            println!(
+                "mesh: {cells} cells per axis from {h0:e} m, grading {:.5}",
+                grading(cells, h0)
+            );
+            mesh_overrides(cells, h0)
         }
     };
+    let mut overrides = overrides;
+    if let Ok(extra) = std::env::var("BUBBLE_SET") {
+        overrides.extend(extra.split(';').filter(|s| !s.is_empty()).map(String::from));
+    }
     let dir = tempfile::tempdir().unwrap();
     let out = std::env::var("BUBBLE_OUT").map_or_else(|_| dir.path().join("run"), PathBuf::from);
     // To 15% past the minimum (before the second maximum), the radius 150 times a cycle.
