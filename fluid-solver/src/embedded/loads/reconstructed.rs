@@ -35,6 +35,7 @@ use crate::embedded::status::NO_SIDE;
 use crate::embedded::Surface;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Cell;
+use rayon::prelude::*;
 
 /// One vertex of a reconstructed polygon: the intersection point, its load density `q` and the
 /// cut it comes from.
@@ -81,21 +82,39 @@ pub(super) fn vertex_loads_in(
     mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
     let joining = joining_cuts(view);
-    let mut polygon = Vec::with_capacity(12);
-    for &k in cells {
-        let cell = &view.mesh.cells[k as usize];
-        let cut_of = cell_cuts(view, &joining, cell);
-        if cut_of.iter().flatten().count() < 3 {
-            continue;
-        }
-        for (cycle, walked) in cycles(cell, &cut_of) {
-            polygon.clear();
-            polygon.extend(cycle.iter().map(|&k| vertex(view, k)));
-            orient(&mut polygon, walked);
-            integrate(view, &polygon, &mut sink);
-        }
+    // The cells' contributions in parallel, handed to `sink` in cell order (as one pass would).
+    let per_chunk: Vec<Vec<Contribution>> = cells
+        .par_chunks(CELLS_PER_TASK)
+        .map(|chunk| {
+            let mut found = Vec::new();
+            let mut polygon = Vec::with_capacity(12);
+            for &k in chunk {
+                let cell = &view.mesh.cells[k as usize];
+                let cut_of = cell_cuts(view, &joining, cell);
+                if cut_of.iter().flatten().count() < 3 {
+                    continue;
+                }
+                for (cycle, walked) in cycles(cell, &cut_of) {
+                    polygon.clear();
+                    polygon.extend(cycle.iter().map(|&k| vertex(view, k)));
+                    orient(&mut polygon, walked);
+                    integrate(view, &polygon, &mut |x, f, t, b| found.push((x, f, t, b)));
+                }
+            }
+            found
+        })
+        .collect();
+    for (x, f, t, b) in per_chunk.into_iter().flatten() {
+        sink(x, f, t, b);
     }
 }
+
+/// One vertex contribution: the point, its force, the structure triangle and the barycentric
+/// coordinates there.
+type Contribution = ([f64; 3], [f64; 3], u32, [f64; 3]);
+
+/// Cut cells per parallel task of [`vertex_loads_in`].
+const CELLS_PER_TASK: usize = 256;
 
 /// Per cut edge, whether it joins the reconstruction (see the module docs): its ends on different
 /// sides, or its triangle on a one-fluid shell.
