@@ -15,6 +15,7 @@
 //! depend only on them, on the target time and on the output times after `t`.
 
 use crate::embedded::advance::{EmbeddedRun, LevelSetStep};
+use crate::embedded::output::SurfaceSeries;
 use crate::embedded::{self};
 use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::output;
@@ -121,6 +122,8 @@ pub struct FluidRun<'a> {
     step: u64,
     t: f64,
     fields: TimeSeriesWriter,
+    /// The embedded surface's own series, opened at its first output.
+    surface_fields: Option<SurfaceSeries>,
     probe_nodes: Vec<usize>,
     probe_csv: ProbeWriter,
     lines: Vec<Line>,
@@ -218,17 +221,23 @@ impl<'a> FluidRun<'a> {
                 let p_cut =
                     case.fluid.as_ref().and_then(|f| f.embedded.as_ref()).and_then(|e| e.p_cut);
                 let mut e = EmbeddedRun::new(p, p_cut, out.path())?;
-                if let Some(r) = restored {
-                    r.restore(&mut e, &semi.mesh)?;
+                match restored {
+                    Some(r) => r.restore(&mut e, &semi.mesh)?,
+                    None => {
+                        // `p*` of the initial state for the first output; the clips of this
+                        // pass are not the run's.
+                        let clips = e.clips;
+                        e.start_pressures(&semi, &ws.prim)?;
+                        e.clips = clips;
+                    }
                 }
                 Some(e)
             }
         };
 
-        let mut fields = output::create_writer(out.path(), &semi.mesh)?;
+        let fields = output::create_writer(out.path(), &semi.mesh)?;
         let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
         let probe_csv = ProbeWriter::fluid(out.path(), &names)?;
-        output::write_fields(&mut fields, &semi, t, &ws.prim, &state.phi)?;
         let bar = Progress::new(t_end, opts.quiet || mode == Mode::Coupled);
         let mut run = FluidRun {
             case,
@@ -246,6 +255,7 @@ impl<'a> FluidRun<'a> {
             step,
             t,
             fields,
+            surface_fields: None,
             probe_nodes,
             probe_csv,
             lines,
@@ -256,6 +266,7 @@ impl<'a> FluidRun<'a> {
             level_set,
             cavitation_clips: 0,
         };
+        run.write_field_step()?;
         run.write_probes()?;
         // Lines asked for at the start time.
         run.write_due_lines()?;
@@ -305,6 +316,25 @@ impl<'a> FluidRun<'a> {
 
     pub fn embedded_mut(&mut self) -> Option<&mut EmbeddedRun> {
         self.embedded.as_mut()
+    }
+
+    /// Writes the fields of the current state (`ws.prim`) and, with an embedded surface, the
+    /// surface's step.
+    fn write_field_step(&mut self) -> anyhow::Result<()> {
+        let tracker = self.embedded.as_ref().map(|e| &e.tracker);
+        let (semi, t) = (&self.semi, self.t);
+        output::write_fields(&mut self.fields, semi, t, &self.ws.prim, &self.state.phi, tracker)?;
+        if let Some(tracker) = tracker {
+            let series = match &mut self.surface_fields {
+                Some(s) => s,
+                None => self
+                    .surface_fields
+                    .insert(SurfaceSeries::create(self.out.path(), &tracker.surface)?),
+            };
+            series.write(t, &semi.mesh, tracker)?;
+        }
+        self.last_fields_step = self.step;
+        Ok(())
     }
 
     fn write_probes(&mut self) -> anyhow::Result<()> {
@@ -430,14 +460,7 @@ impl<'a> FluidRun<'a> {
                 self.write_probes()?;
             }
             if want_fields {
-                output::write_fields(
-                    &mut self.fields,
-                    &self.semi,
-                    t,
-                    &self.ws.prim,
-                    &self.state.phi,
-                )?;
-                self.last_fields_step = step;
+                self.write_field_step()?;
             }
             self.write_due_lines()?;
             if self.mode == Mode::Alone
@@ -493,8 +516,7 @@ impl<'a> FluidRun<'a> {
             let start = Instant::now();
             self.semi.primitives(&self.state.cons, &mut self.ws)?;
             if self.last_fields_step != self.step {
-                let phi = &self.state.phi;
-                output::write_fields(&mut self.fields, &self.semi, self.t, &self.ws.prim, phi)?;
+                self.write_field_step()?;
             }
             for line in &self.lines {
                 let sample = line.sample(&self.ws.prim, &self.state.material, &self.state.phi);
@@ -510,6 +532,9 @@ impl<'a> FluidRun<'a> {
             e.flush()?;
         }
         self.fields.finish()?;
+        if let Some(s) = self.surface_fields.take() {
+            s.finish()?;
+        }
         if self.mode == Mode::Alone {
             write_report(
                 self.case,
