@@ -14,8 +14,9 @@
 //! the part of [`embedded::checkpoint`] beside it), and the time step and the reinitialisations
 //! depend only on them, on the target time and on the output times after `t`.
 
-use crate::embedded::advance::{EmbeddedRun, LevelSetStep};
+use crate::embedded::advance::{active_mass, EmbeddedRun, LevelSetStep};
 use crate::embedded::output::SurfaceSeries;
+use crate::embedded::status::NodeStatus;
 use crate::embedded::{self};
 use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::output;
@@ -31,7 +32,7 @@ use interface_protocol::io::finite::{check_finite, Entity};
 use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::{write_line_sample, ProbeWriter};
 use interface_protocol::io::progress::Progress;
-use interface_protocol::io::report::{self, bucket, RunReport, Timers};
+use interface_protocol::io::report::{self, bucket, RunReport, SurfaceReport, Timers};
 use interface_protocol::io::xdmf::TimeSeriesWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -536,6 +537,8 @@ impl<'a> FluidRun<'a> {
             s.finish()?;
         }
         if self.mode == Mode::Alone {
+            let surface =
+                self.embedded.as_ref().map(|e| surface_report(e, &self.semi, &self.state));
             write_report(
                 self.case,
                 self.case_text,
@@ -547,6 +550,7 @@ impl<'a> FluidRun<'a> {
                 &self.timers,
                 self.wall,
                 self.cavitation_clips,
+                surface,
             )?;
         }
         match self.status {
@@ -571,6 +575,28 @@ pub fn run(case: &Case, case_text: &str, opts: &RunOptions) -> anyhow::Result<Ru
     run.finish()
 }
 
+/// `run.json`'s `surface` section of the embedded surface `e` ([`SurfaceReport`]) with the run's
+/// state `state` (the masses of a run that took no step are the current one).
+fn surface_report(e: &EmbeddedRun, semi: &Semidiscretization, state: &State) -> SurfaceReport {
+    let t = &e.tracker;
+    let count = |s: NodeStatus| t.sides.status.iter().filter(|&&x| x == s).count() as u64;
+    let now = active_mass(semi, &state.cons, &t.active);
+    SurfaceReport {
+        tracking_seconds: e.tracking_s,
+        wall_flux_seconds: e.wall_flux_s,
+        loads_seconds: e.loads_s,
+        cut_edges: t.cuts.cuts.len() as u64,
+        active_nodes: count(NodeStatus::Active),
+        occluded_nodes: count(NodeStatus::Occluded),
+        inactive_nodes: count(NodeStatus::Inactive),
+        mass_start: e.mass.start.unwrap_or(now),
+        mass_end: now,
+        boundary_outflow: e.mass.outflow,
+        mass_change: e.mass.change,
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn write_report(
     case: &Case,
     case_text: &str,
@@ -582,6 +608,7 @@ fn write_report(
     timers: &Timers,
     wall: Instant,
     cavitation_clips: u64,
+    surface: Option<SurfaceReport>,
 ) -> anyhow::Result<()> {
     let mut versions = report::versions();
     versions.insert("fluid-solver".into(), env!("CARGO_PKG_VERSION").into());
@@ -604,6 +631,7 @@ fn write_report(
         .into(),
         wall_seconds: wall.elapsed().as_secs_f64(),
         timings: [("fluid".to_string(), timers.seconds())].into(),
+        surface,
     };
     report.write(&out.run_json())?;
     Ok(())

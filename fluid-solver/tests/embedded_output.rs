@@ -4,8 +4,11 @@
 
 use fluid_solver::embedded::advance::Kinematics;
 use fluid_solver::embedded::status::NodeStatus;
+use fluid_solver::eos::Eos;
+use fluid_solver::riemann::{RiemannSolution, State1d};
 use fluid_solver::solver::{FluidRun, Mode, RunOptions};
 use interface_protocol::case::Case;
+use interface_protocol::io::report::{RunReport, SurfaceReport};
 use std::path::Path;
 use std::process::Command;
 
@@ -190,4 +193,81 @@ fn status_p_wall_and_the_moving_surface_read_back() {
             assert!((p - 1e5).abs() < 1e-10 * 1e5, "t = {t}: p* = {p}");
         }
     }
+}
+
+/// Runs the case file `path` (with `overrides`) alone into `out` through [`FluidRun`]: returns the
+/// active volume `Σ |C_i|` over the active nodes at the start and at the end, and `run.json`'s
+/// surface section.
+fn run_with_volumes(path: &Path, overrides: &[String], out: &Path) -> (f64, f64, SurfaceReport) {
+    let case = Case::load(path, overrides).unwrap();
+    let text = std::fs::read_to_string(path).unwrap();
+    let opts = RunOptions { out: out.to_path_buf(), quiet: true, restart: None, force: false };
+    let mut run = FluidRun::open(&case, &text, &opts, Mode::Alone).unwrap();
+    let volume = |run: &FluidRun| {
+        let (mesh, active) =
+            (&run.semidiscretization().mesh, &run.embedded().unwrap().tracker.active);
+        (0..mesh.n_nodes()).filter(|&i| active[i]).map(|i| mesh.volumes[i]).sum::<f64>()
+    };
+    let v0 = volume(&run);
+    run.advance_to(run.t_end()).unwrap();
+    let v1 = volume(&run);
+    run.finish().unwrap();
+    let report = RunReport::read(&out.join("run.json")).unwrap();
+    (v0, v1, report.surface.expect("an embedded run reports its surface"))
+}
+
+/// `run.json`'s `surface` section. A closed box carried by a uniform flow over exactly one cell
+/// of a mesh that repeats itself cell by cell: the box then covers as much dual volume as at the
+/// start, the flow stays uniform and what enters at `xmin` leaves at `xmax`, so the mass the
+/// surface creates is zero to round-off. The piston (`cases/piston-air`, 130 cells): the wall
+/// creates no mass, so the exact solution puts in the discrete active region of volume `V_A(t)`
+/// the mass `M_0 + ρ* (V_A(t) - V_f(t))` (`V_f = (0.6 - x_wall) A`, the fluid region, `M_0 = ρ_0
+/// V_f(0)`, `ρ*` the exact density behind the shock) and the mass change is that minus `ρ_0
+/// V_A(0)`; no wave reaches the far field, so no mass crosses the boundary.
+#[test]
+fn run_json_reports_the_mass_the_surface_creates() {
+    let dir = tempfile::tempdir().unwrap();
+    // One cell of 1/16 at 10 m/s.
+    let text = carried_box("reconstructed").replace("t_end = 4e-3", "t_end = 6.25e-3");
+    let path = dir.path().join("box.toml");
+    std::fs::write(&path, &text).unwrap();
+    let (v0, v1, s) = run_with_volumes(&path, &[], &dir.path().join("box"));
+    println!("closed box: {s:?}, active volume {v0} -> {v1}");
+    assert!(s.cut_edges > 100 && s.active_nodes > 1000 && s.inactive_nodes > 0);
+    assert!(s.tracking_seconds > 0.0 && s.wall_flux_seconds > 0.0 && s.loads_seconds > 0.0);
+    assert!((v1 - v0).abs() < 1e-12 * v0, "the covered volume changed: {v0} -> {v1}");
+    assert!((s.mass_start - 1.3 * v0).abs() < 1e-12 * s.mass_start);
+    assert!(s.boundary_outflow.abs() < 1e-12 * s.mass_start, "outflow {:e}", s.boundary_outflow);
+    let rel = s.mass_change.abs() / s.mass_start;
+    println!("closed box: mass change {:e} kg, {rel:.2e} of the mass", s.mass_change);
+    assert!(rel < 1e-12, "the closed box creates {:e} kg", s.mass_change);
+    let balance = s.mass_end - s.mass_start + s.boundary_outflow;
+    assert!((balance - s.mass_change).abs() < 1e-12 * s.mass_start);
+
+    let piston = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/piston-air/case.toml");
+    let cells = 130;
+    let overrides =
+        vec![format!("fluid.mesh.box.cells=[{cells},1,1]"), "output.fields_every=0".to_string()];
+    let (v0, v1, s) = run_with_volumes(&piston, &overrides, &dir.path().join("piston"));
+    let eos = Eos::PerfectGas { gamma: 1.4 };
+    let star = RiemannSolution::wall(&eos, State1d { rho: 1.3, u: 0.0, p: 1e5 }, -10.0).unwrap();
+    let rho_star = star.star.rho_l;
+    let area = 0.01 * 0.01;
+    let fluid_volume = |t: f64| (0.6 - (0.001 + 10.0 * t)) * area;
+    let m0 = 1.3 * fluid_volume(0.0);
+    let exact = m0 + rho_star * (v1 - fluid_volume(1.2e-3)) - 1.3 * v0;
+    let cell_mass = 1.3 * 0.65 / cells as f64 * area;
+    println!(
+        "piston: {s:?}; ρ* = {rho_star}, active volume {v0:e} -> {v1:e}; mass change {:e} kg, \
+         exact {exact:e} kg, difference {:.3} of one cell's mass ({cell_mass:e} kg)",
+        s.mass_change,
+        (s.mass_change - exact) / cell_mass
+    );
+    assert!((s.mass_start - 1.3 * v0).abs() < 1e-12 * s.mass_start);
+    assert!(s.boundary_outflow.abs() < 1e-10 * s.mass_start, "outflow {:e}", s.boundary_outflow);
+    assert!(
+        (s.mass_change - exact).abs() < 0.01 * cell_mass,
+        "piston: mass change {:e} kg against {exact:e} kg",
+        s.mass_change
+    );
 }
