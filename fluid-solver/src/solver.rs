@@ -20,7 +20,7 @@ use crate::embedded::status::NodeStatus;
 use crate::embedded::{self};
 use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::output;
-use crate::probes::{Line, Placed};
+use crate::probes::{sampled_state, Line, Placed};
 use crate::semidiscretization::Semidiscretization;
 use crate::setup::{self, Problem};
 use crate::state::{State, Workspace};
@@ -126,6 +126,7 @@ pub struct FluidRun<'a> {
     /// The embedded surface's own series, opened at its first output.
     surface_fields: Option<SurfaceSeries>,
     probe_nodes: Vec<usize>,
+    probe_points: Vec<[f64; 3]>,
     probe_csv: ProbeWriter,
     lines: Vec<Line>,
     last_fields_step: u64,
@@ -165,7 +166,7 @@ impl<'a> FluidRun<'a> {
             level_set,
             ..
         } = problem;
-        let Placed { probe_nodes, mut lines } = placed;
+        let Placed { probe_nodes, probe_points, mut lines } = placed;
         // Read the checkpoint before the output folder is made: it may be the same folder. A
         // fluid-alone run with an embedded surface restarts from a checkpoint holding its state.
         let n_nodes = semi.mesh.n_nodes();
@@ -258,6 +259,7 @@ impl<'a> FluidRun<'a> {
             fields,
             surface_fields: None,
             probe_nodes,
+            probe_points,
             probe_csv,
             lines,
             last_fields_step: step,
@@ -339,8 +341,14 @@ impl<'a> FluidRun<'a> {
     }
 
     fn write_probes(&mut self) -> anyhow::Result<()> {
-        let prim = &self.ws.prim;
-        let row: Vec<f64> = self.probe_nodes.iter().flat_map(|&i| prim[i]).collect();
+        let (prim, mesh) = (&self.ws.prim, &self.semi.mesh);
+        let surface = self.embedded.as_ref().map(|e| &e.tracker);
+        let row: Vec<f64> = self
+            .probe_nodes
+            .iter()
+            .zip(&self.probe_points)
+            .flat_map(|(&i, &x)| sampled_state(mesh, surface, prim, x, i))
+            .collect();
         self.probe_csv.write_row(self.t, &row)?;
         Ok(())
     }
@@ -360,7 +368,10 @@ impl<'a> FluidRun<'a> {
                     line.pending.remove(0);
                 }
                 let name = format!("{}_t{t:.6e}", line.name);
-                let sample = line.sample(&self.ws.prim, &self.state.material, &self.state.phi);
+                let surface = self.embedded.as_ref().map(|e| &e.tracker);
+                let (mesh, prim) = (&self.semi.mesh, &self.ws.prim);
+                let sample =
+                    line.sample(mesh, surface, prim, &self.state.material, &self.state.phi);
                 write_line_sample(&self.out.lines()?, &name, &sample)?;
             }
         }
@@ -520,7 +531,10 @@ impl<'a> FluidRun<'a> {
                 self.write_field_step()?;
             }
             for line in &self.lines {
-                let sample = line.sample(&self.ws.prim, &self.state.material, &self.state.phi);
+                let surface = self.embedded.as_ref().map(|e| &e.tracker);
+                let (mesh, prim) = (&self.semi.mesh, &self.ws.prim);
+                let sample =
+                    line.sample(mesh, surface, prim, &self.state.material, &self.state.phi);
                 write_line_sample(&self.out.lines()?, &line.name, &sample)?;
             }
             self.timers.add_since(bucket::OUTPUT, start);

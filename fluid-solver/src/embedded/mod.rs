@@ -27,6 +27,7 @@ pub mod output;
 pub mod predicates;
 pub mod read;
 pub mod riemann_fs;
+pub mod sample;
 pub mod side_fluid;
 pub mod status;
 pub mod step;
