@@ -159,26 +159,16 @@ fn status_p_wall_and_the_moving_surface_read_back() {
     assert!(times.len() >= 3 && times[0] == 0.0);
     for s in surface {
         let t = s["t"].as_f64().unwrap();
-        let points: Vec<f64> = s["points"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .flat_map(|p| f64s(p))
-            .map(Option::unwrap)
-            .collect();
+        let points: Vec<f64> =
+            s["points"].as_array().unwrap().iter().flat_map(f64s).map(Option::unwrap).collect();
         let exact: Vec<f64> =
             reference.iter().flat_map(|x| [x[0] + 10.0 * t, x[1], x[2]]).collect();
         assert_eq!(points.len(), exact.len());
         let err = points.iter().zip(&exact).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(err < 1e-14, "t = {t}: positions off the motion law by {err:e}");
         assert_eq!(s["cells"], serde_json::json!([["quad", 24]]), "t = {t}");
-        let v: Vec<f64> = s["velocity"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .flat_map(|p| f64s(p))
-            .map(Option::unwrap)
-            .collect();
+        let v: Vec<f64> =
+            s["velocity"].as_array().unwrap().iter().flat_map(f64s).map(Option::unwrap).collect();
         assert!(v.chunks(3).all(|c| c == [10.0, 0.0, 0.0]), "t = {t}: velocity");
         let (plus, minus) = (f64s(&s["p_plus"]), f64s(&s["p_minus"]));
         // One side is the fluid, the other the inside of the box.
