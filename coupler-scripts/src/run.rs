@@ -463,6 +463,7 @@ fn write_report(
         counts: BTreeMap::from([("coupling_steps".to_string(), case.coupling.n_steps())]),
         wall_seconds: wall.as_secs_f64(),
         timings,
+        surface: None,
     };
     let full = LauncherReport {
         report: &report,

@@ -29,6 +29,7 @@ pub mod output;
 pub mod probes;
 pub mod reconstruct;
 pub mod riemann;
+mod run_report;
 pub mod semidiscretization;
 pub mod setup;
 pub mod solver;

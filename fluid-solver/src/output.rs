@@ -1,6 +1,10 @@
 //! Field output of the fluid: the mesh and nodal ρ, velocity, p, Mach and material id as an
-//! XDMF/HDF5 time series (`fluid.h5` + `fluid.xdmf`) through `interface_protocol::io::xdmf`.
+//! XDMF/HDF5 time series (`fluid.h5` + `fluid.xdmf`) through `interface_protocol::io::xdmf`;
+//! with an embedded surface also each node's `status` and the cut-edge pressure `p_wall`
+//! ([`crate::embedded::output`], which also writes the surface's own series).
 
+use crate::embedded::output::mesh_fields;
+use crate::embedded::tracker::Tracker;
 use crate::mesh::{CellKind, Mesh};
 use crate::semidiscretization::Semidiscretization;
 use interface_protocol::io::xdmf::{
@@ -39,13 +43,15 @@ pub fn create_writer(dir: &Path, mesh: &Mesh) -> Result<TimeSeriesWriter, xdmf::
 
 /// Writes one time step of the primitive fields, the Mach number (each node's own sound speed),
 /// the material id of each node (`material`, as a scalar) and, when the run has one, the level
-/// set `phi` (empty: none).
+/// set `phi` (empty: none), and with an embedded surface (`embedded`) the node `status` and
+/// `p_wall` of [`crate::embedded::output`].
 pub fn write_fields(
     writer: &mut TimeSeriesWriter,
     semi: &Semidiscretization,
     time: f64,
     prim: &[[f64; 5]],
     phi: &[f64],
+    embedded: Option<&Tracker>,
 ) -> Result<(), xdmf::XdmfError> {
     let rho: Vec<f64> = prim.iter().map(|w| w[0]).collect();
     let p: Vec<f64> = prim.iter().map(|w| w[4]).collect();
@@ -68,6 +74,19 @@ pub fn write_fields(
     ];
     if !phi.is_empty() {
         fields.push(Field { name: "phi", location: Location::Node, values: Values::Scalar(phi) });
+    }
+    let (status, p_wall) = embedded.map(|t| mesh_fields(&semi.mesh, t)).unwrap_or_default();
+    if embedded.is_some() {
+        fields.push(Field {
+            name: "status",
+            location: Location::Node,
+            values: Values::Scalar(&status),
+        });
+        fields.push(Field {
+            name: "p_wall",
+            location: Location::Node,
+            values: Values::Scalar(&p_wall),
+        });
     }
     writer.write_step(time, &fields)
 }

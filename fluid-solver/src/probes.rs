@@ -1,8 +1,12 @@
 //! Probes and lines: the fluid state sampled at points (`probes.csv`) and along straight lines
 //! (`lines/<name>.csv`). A sample takes the state of the node nearest to the point (exact at
-//! nodes; interpolation inside cells is not done). [`place`] puts a case's probes and lines on
-//! the mesh and refuses any point outside it.
+//! nodes; interpolation inside cells is not done). With an embedded surface it takes the nearest
+//! node that is active and on the point's side of the surface ([`crate::embedded::sample`]), and
+//! a point with none (inside a body) gets `NaN` values and the material [`NO_FLUID`]. [`place`]
+//! puts a case's probes and lines on the mesh and refuses any point outside it.
 
+use crate::embedded::sample::sample_node;
+use crate::embedded::tracker::Tracker;
 use crate::mesh::geometry::{add, dot, norm, scale, sub};
 use crate::mesh::{locate, Mesh};
 use crate::state::MaterialId;
@@ -10,11 +14,41 @@ use crate::time::reached;
 use interface_protocol::case::{FluidLine, FluidProbe};
 use interface_protocol::io::probes::LinePoint;
 
+/// The `material` of a line sample that has no fluid node to read (inside a body).
+pub const NO_FLUID: u32 = u32::MAX;
+
+/// The node a sample at `x` whose nearest node is `nearest` reads: that node without a surface,
+/// [`sample_node`] with one (`None`: no fluid there).
+pub fn sampled_node(
+    mesh: &Mesh,
+    surface: Option<&Tracker>,
+    x: [f64; 3],
+    nearest: usize,
+) -> Option<usize> {
+    match surface {
+        None => Some(nearest),
+        Some(tracker) => sample_node(mesh, tracker, x, nearest),
+    }
+}
+
+/// The primitive state a sample at `x` reads ([`sampled_node`]), `NaN` where there is no fluid.
+pub fn sampled_state(
+    mesh: &Mesh,
+    surface: Option<&Tracker>,
+    prim: &[[f64; 5]],
+    x: [f64; 3],
+    nearest: usize,
+) -> [f64; 5] {
+    sampled_node(mesh, surface, x, nearest).map_or([f64::NAN; 5], |i| prim[i])
+}
+
 /// A case's probes and lines on the mesh.
 #[derive(Debug, Clone)]
 pub struct Placed {
-    /// The node of each probe.
+    /// The node of each probe (nearest to it).
     pub probe_nodes: Vec<usize>,
+    /// Where each probe is.
+    pub probe_points: Vec<[f64; 3]>,
     pub lines: Vec<Line>,
 }
 
@@ -69,7 +103,8 @@ pub fn place(
         first += n;
     }
     let probe_nodes = probes.iter().map(|p| nearest_node(mesh, p.at)).collect();
-    Ok(Placed { probe_nodes, lines })
+    let probe_points = probes.iter().map(|p| p.at).collect();
+    Ok(Placed { probe_nodes, probe_points, lines })
 }
 
 /// The node nearest to `x`.
@@ -119,9 +154,12 @@ impl Line {
 
     /// The samples of the current state: primitive variables, material id (`material` column,
     /// the fluid's id in the EOS table) and level set (`phi`: NaN when `phi` is empty, a run
-    /// without a level set) of each point's node.
+    /// without a level set) of each point's node ([`sampled_node`] with the embedded surface
+    /// `surface`, if any: `NaN` values and material [`NO_FLUID`] where there is no fluid).
     pub fn sample(
         &self,
+        mesh: &Mesh,
+        surface: Option<&Tracker>,
         prim: &[[f64; 5]],
         material: &[MaterialId],
         phi: &[f64],
@@ -130,11 +168,17 @@ impl Line {
         self.points
             .iter()
             .zip(&self.nodes)
-            .map(|(&x, &i)| {
+            .map(|(&x, &nearest)| {
+                let s = norm(sub(x, from));
+                let Some(i) = sampled_node(mesh, surface, x, nearest) else {
+                    let nan = f64::NAN;
+                    let (v, material) = ([nan; 3], NO_FLUID);
+                    return LinePoint { x, s, rho: nan, v, p: nan, material, phi: nan };
+                };
                 let w = prim[i];
                 LinePoint {
                     x,
-                    s: norm(sub(x, from)),
+                    s,
                     rho: w[0],
                     v: [w[1], w[2], w[3]],
                     p: w[4],

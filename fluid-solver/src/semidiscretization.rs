@@ -361,14 +361,23 @@ impl Semidiscretization {
                 }
             }
         }
+        let mut walls = std::time::Duration::ZERO;
         for &s in special.block(b) {
             match (s.kind, wall) {
                 (SpecialKind::TwoMaterial, _) => {
                     crate::two_phase::edge_flux(self, s.edge as usize, prim, r)?
                 }
-                (_, Some(w)) => w.edge_flux(self, s, prim, grad, r)?,
+                (_, Some(w)) => {
+                    let start = std::time::Instant::now();
+                    let f = w.edge_flux(self, s, prim, grad, r);
+                    walls += start.elapsed();
+                    f?
+                }
                 (_, None) => unreachable!("cut and frozen edges come with their wall"),
             }
+        }
+        if let (Some(w), false) = (wall, walls.is_zero()) {
+            w.step.wall_flux_clock.add(walls);
         }
         Ok(())
     }
@@ -497,20 +506,34 @@ impl Semidiscretization {
             let boundary = &self.mesh.boundaries[b];
             for k in node_range(&boundary.nodes, &nodes) {
                 let node = boundary.nodes[k] as usize;
-                let f = bc
-                    .flux(self.numerics.flux, self.eos_at(node), &prim[node], &boundary.normals[k])
-                    .map_err(|error| FluidError::Boundary {
-                        boundary: boundary.name.clone(),
-                        node,
-                        position: self.mesh.coords[node],
-                        error,
-                    })?;
+                let f = self.boundary_flux(b, bc, k, prim)?;
                 for c in 0..5 {
                     r[node][c] += f[c];
                 }
             }
         }
         Ok(())
+    }
+
+    /// The flux of condition `bc` at the `k`-th node of boundary `b`.
+    #[inline]
+    fn boundary_flux(
+        &self,
+        b: usize,
+        bc: BoundaryCondition,
+        k: usize,
+        prim: &[[f64; 5]],
+    ) -> Result<[f64; 5], FluidError> {
+        let boundary = &self.mesh.boundaries[b];
+        let node = boundary.nodes[k] as usize;
+        bc.flux(self.numerics.flux, self.eos_at(node), &prim[node], &boundary.normals[k]).map_err(
+            |error| FluidError::Boundary {
+                boundary: boundary.name.clone(),
+                node,
+                position: self.mesh.coords[node],
+                error,
+            },
+        )
     }
 
     /// Time-step limit of each node for CFL 1 into `ws.dt_node`, from `ws.prim`:
@@ -551,6 +574,26 @@ impl Semidiscretization {
             Ok::<(), std::convert::Infallible>(())
         });
         let Ok(()) = result;
+    }
+
+    /// The mass leaving through the domain's boundary per unit time from the states `prim`: the
+    /// mass component of the boundary fluxes, summed over the boundary nodes `i` with
+    /// `include(i)` (an embedded run's active nodes).
+    pub fn boundary_mass_outflow(
+        &self,
+        prim: &[[f64; 5]],
+        include: impl Fn(usize) -> bool,
+    ) -> Result<f64, FluidError> {
+        let mut total = 0.0;
+        for &(b, bc) in &self.patches {
+            let boundary = &self.mesh.boundaries[b];
+            for k in 0..boundary.nodes.len() {
+                if include(boundary.nodes[k] as usize) {
+                    total += self.boundary_flux(b, bc, k, prim)?[0];
+                }
+            }
+        }
+        Ok(total)
     }
 
     /// `Σ_i R_i` and the total boundary flux `Σ_b F_b`, for conservation checks.

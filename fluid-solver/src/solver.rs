@@ -15,10 +15,12 @@
 //! depend only on them, on the target time and on the output times after `t`.
 
 use crate::embedded::advance::{EmbeddedRun, LevelSetStep};
+use crate::embedded::output::SurfaceSeries;
 use crate::embedded::{self};
 use crate::levelset::{LevelSet, LevelSetWorkspace};
 use crate::output;
-use crate::probes::{Line, Placed};
+use crate::probes::{sampled_state, Line, Placed};
+use crate::run_report::{surface_report, write_report};
 use crate::semidiscretization::Semidiscretization;
 use crate::setup::{self, Problem};
 use crate::state::{State, Workspace};
@@ -30,7 +32,7 @@ use interface_protocol::io::finite::{check_finite, Entity};
 use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::{write_line_sample, ProbeWriter};
 use interface_protocol::io::progress::Progress;
-use interface_protocol::io::report::{self, bucket, RunReport, Timers};
+use interface_protocol::io::report::{bucket, Timers};
 use interface_protocol::io::xdmf::TimeSeriesWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -121,7 +123,10 @@ pub struct FluidRun<'a> {
     step: u64,
     t: f64,
     fields: TimeSeriesWriter,
+    /// The embedded surface's own series, opened at its first output.
+    surface_fields: Option<SurfaceSeries>,
     probe_nodes: Vec<usize>,
+    probe_points: Vec<[f64; 3]>,
     probe_csv: ProbeWriter,
     lines: Vec<Line>,
     last_fields_step: u64,
@@ -161,7 +166,7 @@ impl<'a> FluidRun<'a> {
             level_set,
             ..
         } = problem;
-        let Placed { probe_nodes, mut lines } = placed;
+        let Placed { probe_nodes, probe_points, mut lines } = placed;
         // Read the checkpoint before the output folder is made: it may be the same folder. A
         // fluid-alone run with an embedded surface restarts from a checkpoint holding its state.
         let n_nodes = semi.mesh.n_nodes();
@@ -218,17 +223,23 @@ impl<'a> FluidRun<'a> {
                 let p_cut =
                     case.fluid.as_ref().and_then(|f| f.embedded.as_ref()).and_then(|e| e.p_cut);
                 let mut e = EmbeddedRun::new(p, p_cut, out.path())?;
-                if let Some(r) = restored {
-                    r.restore(&mut e, &semi.mesh)?;
+                match restored {
+                    Some(r) => r.restore(&mut e, &semi.mesh)?,
+                    None => {
+                        // `p*` of the initial state for the first output; the clips of this
+                        // pass are not the run's.
+                        let clips = e.clips;
+                        e.start_pressures(&semi, &ws.prim)?;
+                        e.clips = clips;
+                    }
                 }
                 Some(e)
             }
         };
 
-        let mut fields = output::create_writer(out.path(), &semi.mesh)?;
+        let fields = output::create_writer(out.path(), &semi.mesh)?;
         let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
         let probe_csv = ProbeWriter::fluid(out.path(), &names)?;
-        output::write_fields(&mut fields, &semi, t, &ws.prim, &state.phi)?;
         let bar = Progress::new(t_end, opts.quiet || mode == Mode::Coupled);
         let mut run = FluidRun {
             case,
@@ -246,7 +257,9 @@ impl<'a> FluidRun<'a> {
             step,
             t,
             fields,
+            surface_fields: None,
             probe_nodes,
+            probe_points,
             probe_csv,
             lines,
             last_fields_step: step,
@@ -256,6 +269,7 @@ impl<'a> FluidRun<'a> {
             level_set,
             cavitation_clips: 0,
         };
+        run.write_field_step()?;
         run.write_probes()?;
         // Lines asked for at the start time.
         run.write_due_lines()?;
@@ -307,9 +321,34 @@ impl<'a> FluidRun<'a> {
         self.embedded.as_mut()
     }
 
+    /// Writes the fields of the current state (`ws.prim`) and, with an embedded surface, the
+    /// surface's step.
+    fn write_field_step(&mut self) -> anyhow::Result<()> {
+        let tracker = self.embedded.as_ref().map(|e| &e.tracker);
+        let (semi, t) = (&self.semi, self.t);
+        output::write_fields(&mut self.fields, semi, t, &self.ws.prim, &self.state.phi, tracker)?;
+        if let Some(tracker) = tracker {
+            let series = match &mut self.surface_fields {
+                Some(s) => s,
+                None => self
+                    .surface_fields
+                    .insert(SurfaceSeries::create(self.out.path(), &tracker.surface)?),
+            };
+            series.write(t, &semi.mesh, tracker)?;
+        }
+        self.last_fields_step = self.step;
+        Ok(())
+    }
+
     fn write_probes(&mut self) -> anyhow::Result<()> {
-        let prim = &self.ws.prim;
-        let row: Vec<f64> = self.probe_nodes.iter().flat_map(|&i| prim[i]).collect();
+        let (prim, mesh) = (&self.ws.prim, &self.semi.mesh);
+        let surface = self.embedded.as_ref().map(|e| &e.tracker);
+        let row: Vec<f64> = self
+            .probe_nodes
+            .iter()
+            .zip(&self.probe_points)
+            .flat_map(|(&i, &x)| sampled_state(mesh, surface, prim, x, i))
+            .collect();
         self.probe_csv.write_row(self.t, &row)?;
         Ok(())
     }
@@ -329,7 +368,10 @@ impl<'a> FluidRun<'a> {
                     line.pending.remove(0);
                 }
                 let name = format!("{}_t{t:.6e}", line.name);
-                let sample = line.sample(&self.ws.prim, &self.state.material, &self.state.phi);
+                let surface = self.embedded.as_ref().map(|e| &e.tracker);
+                let (mesh, prim) = (&self.semi.mesh, &self.ws.prim);
+                let sample =
+                    line.sample(mesh, surface, prim, &self.state.material, &self.state.phi);
                 write_line_sample(&self.out.lines()?, &name, &sample)?;
             }
         }
@@ -430,14 +472,7 @@ impl<'a> FluidRun<'a> {
                 self.write_probes()?;
             }
             if want_fields {
-                output::write_fields(
-                    &mut self.fields,
-                    &self.semi,
-                    t,
-                    &self.ws.prim,
-                    &self.state.phi,
-                )?;
-                self.last_fields_step = step;
+                self.write_field_step()?;
             }
             self.write_due_lines()?;
             if self.mode == Mode::Alone
@@ -493,11 +528,13 @@ impl<'a> FluidRun<'a> {
             let start = Instant::now();
             self.semi.primitives(&self.state.cons, &mut self.ws)?;
             if self.last_fields_step != self.step {
-                let phi = &self.state.phi;
-                output::write_fields(&mut self.fields, &self.semi, self.t, &self.ws.prim, phi)?;
+                self.write_field_step()?;
             }
             for line in &self.lines {
-                let sample = line.sample(&self.ws.prim, &self.state.material, &self.state.phi);
+                let surface = self.embedded.as_ref().map(|e| &e.tracker);
+                let (mesh, prim) = (&self.semi.mesh, &self.ws.prim);
+                let sample =
+                    line.sample(mesh, surface, prim, &self.state.material, &self.state.phi);
                 write_line_sample(&self.out.lines()?, &line.name, &sample)?;
             }
             self.timers.add_since(bucket::OUTPUT, start);
@@ -510,7 +547,12 @@ impl<'a> FluidRun<'a> {
             e.flush()?;
         }
         self.fields.finish()?;
+        if let Some(s) = self.surface_fields.take() {
+            s.finish()?;
+        }
         if self.mode == Mode::Alone {
+            let surface =
+                self.embedded.as_ref().map(|e| surface_report(e, &self.semi, &self.state));
             write_report(
                 self.case,
                 self.case_text,
@@ -522,6 +564,7 @@ impl<'a> FluidRun<'a> {
                 &self.timers,
                 self.wall,
                 self.cavitation_clips,
+                surface,
             )?;
         }
         match self.status {
@@ -544,42 +587,4 @@ pub fn run(case: &Case, case_text: &str, opts: &RunOptions) -> anyhow::Result<Ru
         }
     }
     run.finish()
-}
-
-fn write_report(
-    case: &Case,
-    case_text: &str,
-    out: &OutputDir,
-    semi: &Semidiscretization,
-    status: &Result<(), String>,
-    steps: u64,
-    time: f64,
-    timers: &Timers,
-    wall: Instant,
-    cavitation_clips: u64,
-) -> anyhow::Result<()> {
-    let mut versions = report::versions();
-    versions.insert("fluid-solver".into(), env!("CARGO_PKG_VERSION").into());
-    let report = RunReport {
-        case_file: case.source.path.display().to_string(),
-        case: report::case_echo(case_text).unwrap_or(serde_json::Value::Null),
-        versions,
-        status: match status {
-            Ok(()) => "completed".into(),
-            Err(e) => e.clone(),
-        },
-        steps,
-        final_time: time,
-        counts: [
-            ("nodes".to_string(), semi.mesh.n_nodes() as u64),
-            ("edges".to_string(), semi.mesh.n_edges() as u64),
-            ("cells".to_string(), semi.mesh.cells.len() as u64),
-            ("cavitation_clips".to_string(), cavitation_clips),
-        ]
-        .into(),
-        wall_seconds: wall.elapsed().as_secs_f64(),
-        timings: [("fluid".to_string(), timers.seconds())].into(),
-    };
-    report.write(&out.run_json())?;
-    Ok(())
 }

@@ -80,11 +80,35 @@ pub struct EmbeddedRun {
     /// Seconds spent tracking (refit, intersect, sides, fill) and in the loads.
     pub tracking_s: f64,
     pub loads_s: f64,
+    /// Seconds in the cut- and frozen-edge fluxes, summed over threads ([`super::step::FluxClock`]).
+    pub wall_flux_s: f64,
+    /// The fluid mass over the steps taken ([`MassBalance`]).
+    pub mass: MassBalance,
     forces: ProbeWriter,
     /// The last step's view of the boundary, updated from step to step.
     step: Option<EmbeddedStep>,
     /// The edges of the last step's `φ` (with a level set).
     phi_wall: Option<PhiWall>,
+}
+
+/// The mass balance of the steps a run took with the surface (`run.json`'s `surface` section):
+/// `M = Σ |C_i| ρ_i` over the active nodes before the first step and after the last, the mass
+/// that left through the domain's boundary, and the mass the surface created, `Σ_steps (M_after -
+/// M_before + outflow)`: the nodes that change status (covered ones leave `M` with their state,
+/// uncovered ones join it filled) and what the cut-edge fluxes do not conserve. A restarted run
+/// counts from its restart.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct MassBalance {
+    pub start: Option<f64>,
+    pub end: f64,
+    pub outflow: f64,
+    pub change: f64,
+}
+
+/// `Σ |C_i| ρ_i` over the nodes with `active[i]`.
+pub fn active_mass(semi: &Semidiscretization, cons: &[[f64; 5]], active: &[bool]) -> f64 {
+    let volumes = &semi.mesh.volumes;
+    (0..cons.len()).filter(|&i| active[i]).map(|i| volumes[i] * cons[i][0]).sum()
 }
 
 /// The level set of a step with the surface: its settings and scratch, and the number of this
@@ -131,6 +155,8 @@ impl EmbeddedRun {
             clips: 0,
             tracking_s: 0.0,
             loads_s: 0.0,
+            wall_flux_s: 0.0,
+            mass: MassBalance::default(),
             forces,
             step: None,
             phi_wall: None,
@@ -182,6 +208,7 @@ impl EmbeddedRun {
         undo: &mut Undo,
     ) -> anyhow::Result<f64> {
         stable_time_step(semi, &state.cons, ws)?;
+        let mass_before = active_mass(semi, &state.cons, &self.tracker.active);
         let tracker = &self.tracker;
         let dt_cfl = ws
             .dt_node
@@ -258,7 +285,7 @@ impl EmbeddedRun {
             (Some(ls), Some(w)) => Some((w.advection(ls.level_set), &mut *ls.lws)),
             _ => None,
         };
-        rk2_step_embedded(semi, state, ws, dt, &step, tracker, advection)?;
+        let outflow = rk2_step_embedded(semi, state, ws, dt, &step, tracker, advection)?;
         undo.stepped = true;
         if let (Some(ls), Some(w)) = (level_set, &phi_wall) {
             let LevelSetStep { level_set, lws, step_number } = ls;
@@ -297,6 +324,15 @@ impl EmbeddedRun {
         }
         self.forces.write_row(t_b, &[f[0], f[1], f[2], m[0], m[1], m[2]])?;
         self.loads_s += start.elapsed().as_secs_f64();
+        if let Some(step) = &self.step {
+            self.wall_flux_s += step.wall_flux_clock.take_seconds();
+        }
+        let mass_after = active_mass(semi, &state.cons, &self.tracker.active);
+        let mass = &mut self.mass;
+        mass.start.get_or_insert(mass_before);
+        mass.end = mass_after;
+        mass.outflow += outflow;
+        mass.change += mass_after - mass_before + outflow;
         Ok(dt)
     }
 

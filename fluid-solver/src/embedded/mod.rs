@@ -7,7 +7,8 @@
 //! `status` (active, occluded and inactive nodes, sides, swept nodes) -> `riemann_fs` (Alg. 5.1
 //! at every cut edge) -> `loads` (Alg. 5.3 and 5.4). The residual sees all of it through a
 //! read-only view with the stage time; `Semidiscretization` never owns the surface. What a run
-//! carries from step to step goes into its checkpoints ([`checkpoint`]).
+//! carries from step to step goes into its checkpoints ([`checkpoint`]); what it shows in the
+//! field output is in [`output`].
 
 pub mod adjacency;
 pub mod advance;
@@ -22,9 +23,11 @@ pub mod intersect;
 pub mod level_set;
 pub mod loads;
 pub mod motion;
+pub mod output;
 pub mod predicates;
 pub mod read;
 pub mod riemann_fs;
+pub mod sample;
 pub mod side_fluid;
 pub mod status;
 pub mod step;

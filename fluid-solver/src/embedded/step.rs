@@ -16,6 +16,8 @@ use crate::semidiscretization::{FluidError, Semidiscretization};
 use crate::special_edges::{SpecialEdge, SpecialEdges, SpecialKind};
 use interface_protocol::case::InterfaceTreatment;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
 
 /// The embedded boundary as one step's residuals read it.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,6 +38,38 @@ pub struct EmbeddedStep {
     /// The states of the cut-edge fluxes ([`super::riemann_fs::interface`]); the second-order
     /// form needs the scheme's gradients (a first-order scheme takes the first-order form).
     pub interface: InterfaceTreatment,
+    /// Time spent in the fluxes of the cut and frozen edges since it was last taken.
+    pub wall_flux_clock: FluxClock,
+}
+
+/// Nanoseconds summed over the threads that add to it; no part of a step view's state (any two
+/// compare equal, a clone starts from the same count).
+#[derive(Debug, Default)]
+pub struct FluxClock(AtomicU64);
+
+impl FluxClock {
+    /// Adds `d` (called once per block and stage).
+    pub fn add(&self, d: Duration) {
+        let ns = u64::try_from(d.as_nanos()).unwrap_or(u64::MAX);
+        self.0.fetch_add(ns, Ordering::Relaxed);
+    }
+
+    /// The seconds counted so far, resetting the count.
+    pub fn take_seconds(&self) -> f64 {
+        self.0.swap(0, Ordering::Relaxed) as f64 * 1e-9
+    }
+}
+
+impl Clone for FluxClock {
+    fn clone(&self) -> Self {
+        FluxClock(AtomicU64::new(self.0.load(Ordering::Relaxed)))
+    }
+}
+
+impl PartialEq for FluxClock {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// Whether edge `e` is cut, from the sorted cut list.
@@ -92,6 +126,7 @@ impl EmbeddedStep {
             cut,
             frozen,
             interface,
+            wall_flux_clock: FluxClock::default(),
         }
     }
 

@@ -97,7 +97,8 @@ pub fn rk2_step_level_set(
             clipped.fetch_add(1, Ordering::Relaxed);
         }
     };
-    let result = stages_with_phi(semi, state, ws, ratio, None, cut_off, (advection, lws));
+    let result =
+        stages_with_phi(semi, state, ws, ratio, None, cut_off, (advection, lws), |_, _| {});
     if result.is_ok() {
         *clips += clipped.into_inner();
     }
@@ -119,6 +120,9 @@ pub struct PhiAdvection<'a> {
 /// With `level_set`, `φ` advances by the same stages as in [`rk2_step_level_set`], through the
 /// edges of its [`PhiAdvection`] (never across the surface). `ws.prim` must hold the primitives
 /// of `state` (as [`stable_time_step`] leaves them). On error `state` is unchanged.
+///
+/// Returns the mass that left through the domain's boundary in the step, as the two stages apply
+/// it: `Δt/2 (B(Wⁿ) + B(W¹))`, `B` the mass component of the active nodes' boundary fluxes.
 pub fn rk2_step_embedded(
     semi: &Semidiscretization,
     state: &mut State,
@@ -127,20 +131,32 @@ pub fn rk2_step_embedded(
     step: &EmbeddedStep,
     tracker: &Tracker,
     level_set: Option<(PhiAdvection<'_>, &mut LevelSetWorkspace)>,
-) -> Result<(), FluidError> {
-    let ratio = |i: usize| if tracker.active[i] { dt / semi.mesh.volumes[i] } else { 0.0 };
+) -> Result<f64, FluidError> {
+    let active = &tracker.active;
+    let ratio = |i: usize| if active[i] { dt / semi.mesh.volumes[i] } else { 0.0 };
     let (t_a, t_b) = (tracker.surface.t_a, tracker.surface.t_b);
     let walls = [Wall { step, tracker, t: t_a }, Wall { step, tracker, t: t_b }];
-    match level_set {
-        Some(phi) => stages_with_phi(semi, state, ws, ratio, Some(walls), |_, _| {}, phi),
-        None => stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {}, |_, _| {}),
-    }
+    let mut outflow = Ok(0.0);
+    let mut count = |_: usize, ws: &mut Workspace| {
+        if let Ok(total) = &mut outflow {
+            match semi.boundary_mass_outflow(&ws.prim, |i| active[i]) {
+                Ok(b) => *total += 0.5 * dt * b,
+                Err(e) => outflow = Err(e),
+            }
+        }
+    };
+    let result = match level_set {
+        Some(phi) => stages_with_phi(semi, state, ws, ratio, Some(walls), |_, _| {}, phi, count),
+        None => stages(semi, &mut state.cons, ws, ratio, Some(walls), |_, _| {}, &mut count),
+    };
+    result.and(outflow)
 }
 
 /// The two stages of the flow (with `walls`, if any) and of `φ` by `advection` with the
 /// velocities of each stage's flow state, each node's flow state through `floor` as in
 /// [`stages`]; `φ^{n+1}` is built in `lws.stage` and swapped into `state.phi` with the flow, so
-/// on error `state` is unchanged.
+/// on error `state` is unchanged. `after` runs after each stage's flow pass, as in [`stages`].
+#[allow(clippy::too_many_arguments)]
 fn stages_with_phi(
     semi: &Semidiscretization,
     state: &mut State,
@@ -149,6 +165,7 @@ fn stages_with_phi(
     walls: Option<[Wall<'_>; 2]>,
     floor: impl Fn(usize, &mut [f64; 5]) + Sync,
     (advection, lws): (PhiAdvection<'_>, &mut LevelSetWorkspace),
+    mut after: impl FnMut(usize, &mut Workspace),
 ) -> Result<(), FluidError> {
     let mut phi_stage = std::mem::take(&mut lws.stage);
     let State { cons, phi, .. } = state;
@@ -158,6 +175,7 @@ fn stages_with_phi(
     let ratio = &ratio;
     // `ws.prim` holds the primitives of the stage's flow state when each stage's flow pass ends.
     let result = stages(semi, cons, ws, ratio, walls, floor, |stage, ws| {
+        after(stage, ws);
         // The stage's φ (φⁿ, then φ¹) into the advection workspace.
         let source: &[f64] = if stage == 0 { phi_n } else { &phi_stage };
         for (s, p) in lws.phi.iter_mut().zip(source) {

@@ -106,6 +106,38 @@ pub struct RunReport {
     pub wall_seconds: f64,
     /// Process (`"fluid"`, `"structure"`, `"launcher"`) -> bucket -> seconds.
     pub timings: BTreeMap<String, BTreeMap<String, f64>>,
+    /// The embedded surface of a fluid run that has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<SurfaceReport>,
+}
+
+/// `run.json`'s `surface` section: what the embedded boundary cost and what it did to the fluid.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct SurfaceReport {
+    /// Wall seconds of the tracking (refit, intersections, sides, filling the swept nodes).
+    pub tracking_seconds: f64,
+    /// Seconds in the fluxes of the cut and frozen edges (Alg. 5.1 and the slip walls), summed
+    /// over the threads that computed them.
+    pub wall_flux_seconds: f64,
+    /// Wall seconds of `p*` at the cut edges and the loads (Alg. 5.3 or 5.4).
+    pub loads_seconds: f64,
+    /// Cut edges at the end of the run.
+    pub cut_edges: u64,
+    /// Active, occluded and inactive mesh nodes at the end of the run.
+    pub active_nodes: u64,
+    pub occluded_nodes: u64,
+    pub inactive_nodes: u64,
+    /// Fluid mass `M = Σ |C_i| ρ_i` over the active nodes at the start and at the end (kg).
+    pub mass_start: f64,
+    pub mass_end: f64,
+    /// Net mass that left through the domain's boundary over the run (kg; the time integral of
+    /// the mass component of the boundary fluxes of the active nodes, as the scheme applies them).
+    pub boundary_outflow: f64,
+    /// The mass the surface created (positive) or destroyed: `mass_end - mass_start +
+    /// boundary_outflow`, accumulated step by step (kg). It includes the mass of the nodes that
+    /// change status (covered nodes leave `M` with their state, uncovered ones join it with
+    /// the state they are filled with) and whatever the cut-edge fluxes do not conserve.
+    pub mass_change: f64,
 }
 
 impl RunReport {
@@ -170,6 +202,11 @@ mod tests {
             counts: BTreeMap::from([("fluid_nodes".to_string(), 4096)]),
             wall_seconds: 3.25,
             timings: BTreeMap::from([("fluid".to_string(), timers.seconds())]),
+            surface: Some(SurfaceReport {
+                cut_edges: 12,
+                mass_change: -1.5e-9,
+                ..Default::default()
+            }),
         };
         let path = dir.path().join("run.json");
         report.write(&path).unwrap();

@@ -164,6 +164,7 @@ pub fn run(opts: &RunOptions) -> anyhow::Result<RunSummary> {
             .collect(),
         wall_seconds: started.elapsed().as_secs_f64(),
         timings: [("structure".to_string(), timers.seconds())].into_iter().collect(),
+        surface: None,
     };
     report.write(&dir.run_json())?;
     result?;
