@@ -451,7 +451,7 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
 /// updates, warm-up steps, timed steps, scaled rotary inertia), 15 `f64` (`C00 C01 C22 κG E
 /// c1 c2 H σy r tol c 12κG ρ dt0`), the points and weights, positions, velocities and inverse
 /// masses per node, thickness and connectivity (`u32`) per element.
-fn c_reference(
+pub fn c_reference(
     plate: &Bt4Plate,
     warmup: usize,
     steps: usize,
