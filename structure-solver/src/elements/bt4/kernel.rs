@@ -26,6 +26,11 @@ fn cross<R: Real>(a: [R; 3], b: [R; 3]) -> [R; 3] {
 }
 
 #[inline(always)]
+fn sub<R: Real>(a: [R; 3], b: [R; 3]) -> [R; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
 fn dot<R: Real>(a: [R; 3], b: [R; 3]) -> R {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -39,14 +44,18 @@ fn normalize<R: Real>(a: [R; 3]) -> [R; 3] {
 /// Corotated frame, projected local coordinates and the one-point `b = ∂N/∂x̂` at the centre.
 #[inline(always)]
 pub(super) fn frame<R: Real>(x: &[[R; 3]; 4]) -> Frame<R> {
-    let sub = |a: [R; 3], b: [R; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let e3 = normalize(cross(sub(x[2], x[0]), sub(x[3], x[1])));
     let x21 = sub(x[1], x[0]);
     let d = dot(x21, e3);
     let e1 = normalize([x21[0] - d * e3[0], x21[1] - d * e3[1], x21[2] - d * e3[2]]);
     let e2 = cross(e3, e1);
     let quarter = R::splat(0.25);
-    let c: [R; 3] = std::array::from_fn(|k| (x[0][k] + x[1][k] + x[2][k] + x[3][k]) * quarter);
+    // Functions and loops rather than closures over lanes: a closure is compiled apart from
+    // the instruction set of the kernel, so its vector operations may stay calls.
+    let mut c = [R::splat(0.0); 3];
+    for k in 0..3 {
+        c[k] = (x[0][k] + x[1][k] + x[2][k] + x[3][k]) * quarter;
+    }
     let mut lx = [R::splat(0.0); 4];
     let mut ly = lx;
     let mut lz = lx;
@@ -260,7 +269,10 @@ pub(super) fn element_block<V: Block8>(
     let hv = [one, minus_one, one, minus_one];
     let hx = hv[0] * fe.x[0] + hv[1] * fe.x[1] + hv[2] * fe.x[2] + hv[3] * fe.x[3];
     let hy = hv[0] * fe.y[0] + hv[1] * fe.y[1] + hv[2] * fe.y[2] + hv[3] * fe.y[3];
-    let g: [V; 4] = std::array::from_fn(|i| quarter * (hv[i] - hx * fe.b1[i] - hy * fe.b2[i]));
+    let mut g = [zero; 4];
+    for i in 0..4 {
+        g[i] = quarter * (hv[i] - hx * fe.b1[i] - hy * fe.b2[i]);
+    }
     let mut bb = zero;
     for i in 0..4 {
         bb += fe.b1[i] * fe.b1[i] + fe.b2[i] * fe.b2[i];
