@@ -7,6 +7,7 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::assembly::{Curve, FeModel, Part};
@@ -22,6 +23,8 @@ use crate::time::{Implicit, ImplicitScheme};
 #[derive(Debug, Serialize)]
 pub struct BenchReport {
     pub explicit_bt4: ExplicitBench,
+    /// The 3-node shell on the same number of elements.
+    pub explicit_blt3: crate::bench_blt3::Blt3Bench,
     pub implicit_newmark: Option<ImplicitBench>,
     /// The factor reused as the GMRES preconditioner, on 1 and 2 threads.
     pub implicit_factor_reuse: crate::bench_implicit::ImplicitReuseBench,
@@ -195,7 +198,7 @@ fn pieces(model: &mut FeModel) -> anyhow::Result<IterationPieces> {
     })
 }
 
-fn steel() -> J2 {
+pub(crate) fn steel() -> J2 {
     J2 { elastic: Elastic { e: 200e9, nu: 0.3, rho: 7800.0 }, sigma_y: 250e6, h: 1e9 }
 }
 
@@ -235,18 +238,24 @@ impl Bt4Plate {
         NumberingLocality { order, renumbered, bandwidth, profile, mean_element_spread }
     }
 
-    /// Initial velocity (6 per node): a biaxial stretch at 160/s and a transverse sine at
-    /// 20 m/s, so the points yield after a few steps and keep yielding.
+    /// The initial velocity of the bench ([`plate_velocity`]).
     pub fn velocity(&self) -> Vec<f64> {
-        let mut v = vec![0.0; 6 * self.x0.len()];
-        let pi = std::f64::consts::PI;
-        for (i, p) in self.x0.iter().enumerate() {
-            v[6 * i] = 160.0 * (p[0] - 0.5);
-            v[6 * i + 1] = -40.0 * (p[1] - 0.5);
-            v[6 * i + 2] = 20.0 * (pi * p[0]).sin() * (pi * p[1]).sin();
-        }
-        v
+        plate_velocity(&self.x0)
     }
+}
+
+/// Initial velocity (6 per node) of a bench plate on the unit square: a biaxial stretch at
+/// 160/s and a transverse sine at 20 m/s, so the points yield after a few steps and keep
+/// yielding.
+pub(crate) fn plate_velocity(x0: &[[f64; 3]]) -> Vec<f64> {
+    let mut v = vec![0.0; 6 * x0.len()];
+    let pi = std::f64::consts::PI;
+    for (i, p) in x0.iter().enumerate() {
+        v[6 * i] = 160.0 * (p[0] - 0.5);
+        v[6 * i + 1] = -40.0 * (p[1] - 0.5);
+        v[6 * i + 2] = 20.0 * (pi * p[0]).sin() * (pi * p[1]).sin();
+    }
+    v
 }
 
 /// Free explicit dynamics of a BT4 plate (central difference, no load).
@@ -282,26 +291,10 @@ impl Bt4Explicit {
     /// One whole step: `Δu = dt v`, `x += Δu`, internal forces, commit, `v -= dt f / m`, the
     /// next stable step.
     pub fn step(&mut self) {
-        use rayon::prelude::*;
-        let dt = self.dt;
-        (self.x.par_iter_mut(), self.du.par_chunks_mut(6), self.v.par_chunks(6))
-            .into_par_iter()
-            .with_min_len(4096)
-            .for_each(|(x, du, v)| {
-                for k in 0..6 {
-                    du[k] = dt * v[k];
-                }
-                for k in 0..3 {
-                    x[k] += du[k];
-                }
-            });
-        self.f.par_iter_mut().with_min_len(4096).for_each(|f| *f = 0.0);
+        advance_positions(self.dt, &mut self.x, &mut self.du, &self.v, &mut self.f);
         self.bt4.internal_force(&self.x, &self.du, &mut self.f);
         self.bt4.commit();
-        (self.v.par_iter_mut(), self.f.par_iter(), self.inv_mass.par_iter())
-            .into_par_iter()
-            .with_min_len(4096)
-            .for_each(|(v, f, im)| *v -= dt * f * im);
+        update_velocities(self.dt, &mut self.v, &self.f, &self.inv_mass);
         self.dt = 0.9 * self.bt4.stable_dt(&self.x);
     }
 
@@ -312,6 +305,44 @@ impl Bt4Explicit {
             .map(|(e, p)| self.bt4.plastic_strain(e, p))
             .collect()
     }
+}
+
+/// The first half of a central-difference step of a free explicit bench: `Δu = dt v` (6 per
+/// node), `x += Δu` (translations), and the forces `f` zeroed.
+pub(crate) fn advance_positions(
+    dt: f64,
+    x: &mut [[f64; 3]],
+    du: &mut [f64],
+    v: &[f64],
+    f: &mut [f64],
+) {
+    (x.par_iter_mut(), du.par_chunks_mut(6), v.par_chunks(6))
+        .into_par_iter()
+        .with_min_len(4096)
+        .for_each(|(x, du, v)| {
+            for k in 0..6 {
+                du[k] = dt * v[k];
+            }
+            for k in 0..3 {
+                x[k] += du[k];
+            }
+        });
+    f.par_iter_mut().with_min_len(4096).for_each(|f| *f = 0.0);
+}
+
+/// The second half: `v -= dt f / m` with the inverse lumped masses.
+pub(crate) fn update_velocities(dt: f64, v: &mut [f64], f: &[f64], inv_mass: &[f64]) {
+    (v.par_iter_mut(), f.par_iter(), inv_mass.par_iter())
+        .into_par_iter()
+        .with_min_len(4096)
+        .for_each(|(v, f, im)| *v -= dt * f * im);
+}
+
+/// Processor time of the process (all threads) around `f`, with its wall-clock seconds.
+pub(crate) fn timed(f: impl FnOnce()) -> (f64, f64) {
+    let (t0, c0) = (Instant::now(), process_cpu_seconds());
+    f();
+    (t0.elapsed().as_secs_f64(), process_cpu_seconds() - c0)
 }
 
 /// Times whole explicit steps of BT4 + J2 (5 points, plane-stress return) on a plate of about
@@ -582,9 +613,15 @@ pub fn implicit(n: usize, steps: usize) -> anyhow::Result<ImplicitBench> {
 pub fn run(quick: bool, elements: usize, threads: &[usize]) -> anyhow::Result<BenchReport> {
     let explicit =
         if quick { explicit(400, 5, threads)? } else { explicit(elements, 100, threads)? };
+    let blt3 = if quick {
+        crate::bench_blt3::run(400, 5, threads)?
+    } else {
+        crate::bench_blt3::run(elements, 100, threads)?
+    };
     let implicit = if quick { implicit(10, 2)? } else { implicit(100, 3)? };
     Ok(BenchReport {
         explicit_bt4: explicit,
+        explicit_blt3: blt3,
         implicit_newmark: Some(implicit),
         implicit_factor_reuse: crate::bench_implicit::run(quick)?,
     })
