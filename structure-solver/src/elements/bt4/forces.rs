@@ -11,10 +11,12 @@
 //! thread the blocks add their forces to the nodes as they go, in ascending element order: the
 //! same sums without the work array.
 //!
-//! The vector width is chosen at run time ([`SimdPath`]): the block loop is compiled for
-//! AVX-512 (x86-64-v4), AVX2 + FMA (x86-64-v3) and the baseline (SSE2) through `pulp`, and
-//! the widest the processor has runs. The kernel never asks for fused multiply-adds, so every
-//! path does the same IEEE operations and gives the same bits.
+//! The vector width is chosen at run time ([`SimdPath`], detected through `pulp`): the block
+//! loop is compiled in functions of the AVX-512 (x86-64-v4) and AVX2 + FMA (x86-64-v3)
+//! instruction sets on the lanes of `material::lanes_x86` (one or two registers per block),
+//! and for the baseline (SSE2) on [`Lanes`]; the widest the processor has runs. The kernel
+//! never asks for fused multiply-adds, so every path does the same IEEE operations and gives
+//! the same bits.
 
 use rayon::prelude::*;
 
