@@ -224,7 +224,7 @@ impl Bt4Plate {
         NumberingLocality { order, renumbered, bandwidth, profile, mean_element_spread }
     }
 
-    /// The initial velocity of the bench ([`plate_velocity`]).
+    /// The initial velocity of the bench (`plate_velocity`).
     pub fn velocity(&self) -> Vec<f64> {
         plate_velocity(&self.x0)
     }

@@ -160,7 +160,7 @@ impl<const N: usize> Real for Lanes<N> {
 }
 
 /// Eight lanes read from and written to arrays: the blocks of the element kernels, as
-/// [`Lanes`] or as vector registers of one instruction set ([`super::lanes_x86`]).
+/// [`Lanes`] or as vector registers of one instruction set (`lanes_x86`).
 pub trait Block8: Real {
     fn from_array(a: [f64; 8]) -> Self;
     fn to_array(self) -> [f64; 8];
