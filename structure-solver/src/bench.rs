@@ -7,6 +7,7 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::assembly::{Curve, FeModel, Part};
@@ -22,6 +23,8 @@ use crate::time::{Implicit, ImplicitScheme};
 #[derive(Debug, Serialize)]
 pub struct BenchReport {
     pub explicit_bt4: ExplicitBench,
+    /// The 3-node shell on the same number of elements.
+    pub explicit_blt3: crate::bench_blt3::Blt3Bench,
     pub implicit_newmark: Option<ImplicitBench>,
     /// The factor reused as the GMRES preconditioner, on 1 and 2 threads.
     pub implicit_factor_reuse: crate::bench_implicit::ImplicitReuseBench,
@@ -52,21 +55,7 @@ pub struct ExplicitBench {
     pub c_reference: CReference,
 }
 
-/// The C reference `bench/bt4.c` (gcc -O3 -march=native -ffp-contract=off, blocked by 8).
-#[derive(Debug, Serialize)]
-pub struct CReference {
-    /// Why it did not run (no C compiler at build time, or it failed).
-    pub unavailable: Option<String>,
-    pub element_updates_per_s: Option<f64>,
-    pub element_updates_per_cpu_s: Option<f64>,
-    /// Rust on one thread (natural order) over C: above 1 when Rust is faster.
-    pub rust_over_c: Option<f64>,
-    /// The same per second of processor time.
-    pub rust_over_c_cpu: Option<f64>,
-    /// Largest difference of the end positions of the C and the Rust run, relative to the
-    /// largest coordinate (round-off: the same operations in the same order).
-    pub position_difference: Option<f64>,
-}
+pub use crate::bench_c::{c_reference, CReference};
 
 /// What the locality renumbering does to the bench plate: rates of the first thread count
 /// (natural over shuffled numbering, renumbered over as given), and the node-graph profile and
@@ -195,7 +184,7 @@ fn pieces(model: &mut FeModel) -> anyhow::Result<IterationPieces> {
     })
 }
 
-fn steel() -> J2 {
+pub(crate) fn steel() -> J2 {
     J2 { elastic: Elastic { e: 200e9, nu: 0.3, rho: 7800.0 }, sigma_y: 250e6, h: 1e9 }
 }
 
@@ -235,18 +224,24 @@ impl Bt4Plate {
         NumberingLocality { order, renumbered, bandwidth, profile, mean_element_spread }
     }
 
-    /// Initial velocity (6 per node): a biaxial stretch at 160/s and a transverse sine at
-    /// 20 m/s, so the points yield after a few steps and keep yielding.
+    /// The initial velocity of the bench (`plate_velocity`).
     pub fn velocity(&self) -> Vec<f64> {
-        let mut v = vec![0.0; 6 * self.x0.len()];
-        let pi = std::f64::consts::PI;
-        for (i, p) in self.x0.iter().enumerate() {
-            v[6 * i] = 160.0 * (p[0] - 0.5);
-            v[6 * i + 1] = -40.0 * (p[1] - 0.5);
-            v[6 * i + 2] = 20.0 * (pi * p[0]).sin() * (pi * p[1]).sin();
-        }
-        v
+        plate_velocity(&self.x0)
     }
+}
+
+/// Initial velocity (6 per node) of a bench plate on the unit square: a biaxial stretch at
+/// 160/s and a transverse sine at 20 m/s, so the points yield after a few steps and keep
+/// yielding.
+pub(crate) fn plate_velocity(x0: &[[f64; 3]]) -> Vec<f64> {
+    let mut v = vec![0.0; 6 * x0.len()];
+    let pi = std::f64::consts::PI;
+    for (i, p) in x0.iter().enumerate() {
+        v[6 * i] = 160.0 * (p[0] - 0.5);
+        v[6 * i + 1] = -40.0 * (p[1] - 0.5);
+        v[6 * i + 2] = 20.0 * (pi * p[0]).sin() * (pi * p[1]).sin();
+    }
+    v
 }
 
 /// Free explicit dynamics of a BT4 plate (central difference, no load).
@@ -282,26 +277,10 @@ impl Bt4Explicit {
     /// One whole step: `Δu = dt v`, `x += Δu`, internal forces, commit, `v -= dt f / m`, the
     /// next stable step.
     pub fn step(&mut self) {
-        use rayon::prelude::*;
-        let dt = self.dt;
-        (self.x.par_iter_mut(), self.du.par_chunks_mut(6), self.v.par_chunks(6))
-            .into_par_iter()
-            .with_min_len(4096)
-            .for_each(|(x, du, v)| {
-                for k in 0..6 {
-                    du[k] = dt * v[k];
-                }
-                for k in 0..3 {
-                    x[k] += du[k];
-                }
-            });
-        self.f.par_iter_mut().with_min_len(4096).for_each(|f| *f = 0.0);
+        advance_positions(self.dt, &mut self.x, &mut self.du, &self.v, &mut self.f);
         self.bt4.internal_force(&self.x, &self.du, &mut self.f);
         self.bt4.commit();
-        (self.v.par_iter_mut(), self.f.par_iter(), self.inv_mass.par_iter())
-            .into_par_iter()
-            .with_min_len(4096)
-            .for_each(|(v, f, im)| *v -= dt * f * im);
+        update_velocities(self.dt, &mut self.v, &self.f, &self.inv_mass);
         self.dt = 0.9 * self.bt4.stable_dt(&self.x);
     }
 
@@ -312,6 +291,44 @@ impl Bt4Explicit {
             .map(|(e, p)| self.bt4.plastic_strain(e, p))
             .collect()
     }
+}
+
+/// The first half of a central-difference step of a free explicit bench: `Δu = dt v` (6 per
+/// node), `x += Δu` (translations), and the forces `f` zeroed.
+pub(crate) fn advance_positions(
+    dt: f64,
+    x: &mut [[f64; 3]],
+    du: &mut [f64],
+    v: &[f64],
+    f: &mut [f64],
+) {
+    (x.par_iter_mut(), du.par_chunks_mut(6), v.par_chunks(6))
+        .into_par_iter()
+        .with_min_len(4096)
+        .for_each(|(x, du, v)| {
+            for k in 0..6 {
+                du[k] = dt * v[k];
+            }
+            for k in 0..3 {
+                x[k] += du[k];
+            }
+        });
+    f.par_iter_mut().with_min_len(4096).for_each(|f| *f = 0.0);
+}
+
+/// The second half: `v -= dt f / m` with the inverse lumped masses.
+pub(crate) fn update_velocities(dt: f64, v: &mut [f64], f: &[f64], inv_mass: &[f64]) {
+    (v.par_iter_mut(), f.par_iter(), inv_mass.par_iter())
+        .into_par_iter()
+        .with_min_len(4096)
+        .for_each(|(v, f, im)| *v -= dt * f * im);
+}
+
+/// Processor time of the process (all threads) around `f`, with its wall-clock seconds.
+pub(crate) fn timed(f: impl FnOnce()) -> (f64, f64) {
+    let (t0, c0) = (Instant::now(), process_cpu_seconds());
+    f();
+    (t0.elapsed().as_secs_f64(), process_cpu_seconds() - c0)
 }
 
 /// Times whole explicit steps of BT4 + J2 (5 points, plane-stress return) on a plate of about
@@ -446,93 +463,6 @@ pub fn explicit(elements: usize, steps: usize, threads: &[usize]) -> anyhow::Res
     })
 }
 
-/// Runs the C reference on `plate` (`warmup` untimed and `steps` timed steps): its seconds
-/// and end positions. The input file: 8 `u64` (magic, nodes, elements, points, Newton
-/// updates, warm-up steps, timed steps, scaled rotary inertia), 15 `f64` (`C00 C01 C22 κG E
-/// c1 c2 H σy r tol c 12κG ρ dt0`), the points and weights, positions, velocities and inverse
-/// masses per node, thickness and connectivity (`u32`) per element.
-fn c_reference(
-    plate: &Bt4Plate,
-    warmup: usize,
-    steps: usize,
-) -> anyhow::Result<(f64, f64, Vec<[f64; 3]>)> {
-    use crate::elements::section::SHEAR_FACTOR;
-    use crate::elements::RotaryInertia;
-    use anyhow::Context;
-    let exe = env!("BT4_C_REFERENCE");
-    anyhow::ensure!(!exe.is_empty(), "bench/bt4.c was not compiled (no C compiler at build time)");
-    let sim = Bt4Explicit::new(plate);
-    let (bt4, set) = (&sim.bt4, &sim.bt4.settings);
-    let m = bt4.materials()[0];
-    let el = m.elastic;
-    let c = el.tangent_plane_stress();
-    let ret = m.plane_stress_constants::<f64>();
-    let mut buf: Vec<u8> = Vec::new();
-    let header = [
-        0x3146_4552_4334_4254u64,
-        plate.x0.len() as u64,
-        plate.conn.len() as u64,
-        set.rule.len() as u64,
-        set.newton as u64,
-        warmup as u64,
-        steps as u64,
-        u64::from(set.rotary == RotaryInertia::Scaled),
-    ];
-    header.iter().for_each(|v| buf.extend(v.to_le_bytes()));
-    let consts = [
-        c[0][0],
-        c[0][1],
-        c[2][2],
-        SHEAR_FACTOR * el.shear_modulus(),
-        el.e,
-        ret.c1,
-        ret.c2,
-        ret.h,
-        ret.sigma_y,
-        set.hourglass,
-        set.return_tol,
-        el.plate_wave_speed(),
-        12.0 * SHEAR_FACTOR * el.shear_modulus(),
-        el.rho,
-        sim.dt,
-    ];
-    let reals = consts
-        .iter()
-        .chain(&set.rule.points)
-        .chain(&set.rule.weights)
-        .chain(sim.x.iter().flatten())
-        .chain(&sim.v)
-        .chain(&sim.inv_mass)
-        .chain(&bt4.thickness);
-    reals.for_each(|v| buf.extend(v.to_le_bytes()));
-    bt4.conn.iter().flatten().for_each(|v| buf.extend(v.to_le_bytes()));
-    let dir = std::env::temp_dir();
-    let tag = format!("bt4-c-{}", std::process::id());
-    let (input, output) = (dir.join(format!("{tag}.in")), dir.join(format!("{tag}.out")));
-    std::fs::write(&input, &buf).with_context(|| format!("writing {}", input.display()))?;
-    let run = std::process::Command::new(exe).arg(&input).arg(&output).output();
-    let _ = std::fs::remove_file(&input);
-    let run = run.with_context(|| format!("running {exe}"))?;
-    anyhow::ensure!(run.status.success(), "{exe}: {}", String::from_utf8_lossy(&run.stderr));
-    let report: serde_json::Value = serde_json::from_slice(&run.stdout)?;
-    let secs = report["seconds"].as_f64().context("the C reference printed no seconds")?;
-    let cpu = report["cpu_seconds"].as_f64().context("the C reference printed no cpu_seconds")?;
-    let bytes = std::fs::read(&output).with_context(|| format!("reading {}", output.display()))?;
-    let _ = std::fs::remove_file(&output);
-    anyhow::ensure!(
-        bytes.len() == 24 * plate.x0.len(),
-        "the C reference wrote {} bytes",
-        bytes.len()
-    );
-    let x = bytes
-        .chunks_exact(24)
-        .map(|p| {
-            std::array::from_fn(|k| f64::from_le_bytes(p[8 * k..8 * k + 8].try_into().unwrap()))
-        })
-        .collect();
-    Ok((secs, cpu, x))
-}
-
 /// Processor time of this process (user + system, all threads) from `/proc/self/stat`, in
 /// seconds (ticks of 1/100 s); 0 where there is no `/proc`.
 fn process_cpu_seconds() -> f64 {
@@ -582,9 +512,15 @@ pub fn implicit(n: usize, steps: usize) -> anyhow::Result<ImplicitBench> {
 pub fn run(quick: bool, elements: usize, threads: &[usize]) -> anyhow::Result<BenchReport> {
     let explicit =
         if quick { explicit(400, 5, threads)? } else { explicit(elements, 100, threads)? };
+    let blt3 = if quick {
+        crate::bench_blt3::run(400, 5, threads)?
+    } else {
+        crate::bench_blt3::run(elements, 100, threads)?
+    };
     let implicit = if quick { implicit(10, 2)? } else { implicit(100, 3)? };
     Ok(BenchReport {
         explicit_bt4: explicit,
+        explicit_blt3: blt3,
         implicit_newmark: Some(implicit),
         implicit_factor_reuse: crate::bench_implicit::run(quick)?,
     })

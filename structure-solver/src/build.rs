@@ -341,6 +341,11 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
     let mut fe =
         FeModel::new(&elements, part).map_err(|e| field_error(case, "structure.parts", e))?;
     fe.set_rotary_inertia(rotary);
+    // The user's ids (gmsh node tags, else the input numbers) in the topology layer, apart
+    // from the storage slots of the renumbered mesh.
+    let node_ids = (0..mesh.nodes.len()).map(|s| mesh.node_id(s)).collect();
+    let cell_ids = kept.iter().map(|&c| mesh.cell_user(c) as u64).collect();
+    fe.set_ids(node_ids, cell_ids).map_err(|e| field_error(case, "structure.mesh", e))?;
     let mut mesh = mesh;
     // Rigid body of each slave node.
     let mut body_of = vec![None; mesh.nodes.len()];

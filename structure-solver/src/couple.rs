@@ -438,13 +438,13 @@ impl Participant {
                 )
             })?;
         }
-        if self.fields_every > 0 && (n + 1) % self.fields_every == 0 {
+        if self.fields_every > 0 && (n + 1).is_multiple_of(self.fields_every) {
             self.write_fields()?;
         }
         if let Some(bar) = self.bar.as_mut() {
             bar.update(n + 1, t_to, dt);
         }
-        if (n + 1) % self.probes_every == 0 || t_to >= self.t_end * (1.0 - 1e-12) {
+        if (n + 1).is_multiple_of(self.probes_every) || t_to >= self.t_end * (1.0 - 1e-12) {
             self.write_probes()?;
         }
         Ok(())

@@ -13,6 +13,8 @@
 
 pub mod assembly;
 pub mod bench;
+pub mod bench_blt3;
+pub mod bench_c;
 pub mod bench_implicit;
 pub mod build;
 pub mod case_mesh;

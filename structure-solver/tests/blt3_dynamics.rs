@@ -259,7 +259,7 @@ fn sze_cantilever_on_32_triangles_reaches_the_published_static_states() {
             run.step(&mut part, dt, &f_ext, alpha, first);
             first = false;
             k += 1;
-            if k > ramp && k % 200 == 0 && run.residual(&f_ext) < 1e-6 * 4.0 {
+            if k > ramp && k.is_multiple_of(200) && run.residual(&f_ext) < 1e-6 * 4.0 {
                 break;
             }
             assert!(k < 400_000, "no static state at P/Pmax {target}");

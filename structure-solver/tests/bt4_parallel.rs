@@ -108,7 +108,7 @@ fn forces_and_state_are_bitwise_the_same_on_1_and_2_threads() {
     // 31 x 27 = 837 elements: 105 blocks (the last one partial), 7 tasks of the block phase.
     let plate = Plate::new(31, 27);
     let ne = plate.conn.len();
-    assert!(ne > 4 * BLOCKS_PER_TASK * LANES && ne % LANES != 0);
+    assert!(ne > 4 * BLOCKS_PER_TASK * LANES && !ne.is_multiple_of(LANES));
     let run = |threads: usize| {
         let mut bt4 = Bt4::new(plate.conn.clone(), vec![0.01; ne], steel(), Bt4Settings::default());
         let f = pool(threads).install(|| drive(&plate, &mut bt4, 12, SimdPath::detected()));

@@ -338,7 +338,7 @@ fn sze_cantilever_on_32_triangles_through_the_model_reaches_the_published_states
             model.internal_force(&mut fi);
             model.commit();
             k += 1;
-            if k > ramp && k % 200 == 0 {
+            if k > ramp && k.is_multiple_of(200) {
                 let c = model.constrained();
                 let res =
                     (0..n).filter(|&i| !c[i]).map(|i| (f_ext[i] - fi[i]).abs()).fold(0.0, f64::max);

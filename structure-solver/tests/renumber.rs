@@ -306,3 +306,60 @@ fn the_wet_surface_keeps_the_users_order_when_renumbered() {
         assert!(!given.elements.is_empty());
     }
 }
+
+/// A model built from a case is stored in the renumbered order but keeps the user's ids in
+/// its topology layer: node id `j (nx + 1) + i` of the rectangle generator names the node at
+/// `(i / nx, j / ny)` and element id `j nx + i` the cell with those corner nodes, whatever slot
+/// the renumbering gave them.
+#[test]
+fn a_model_built_from_a_case_names_nodes_and_elements_by_user_id() {
+    use interface_protocol::case::Case;
+    use structure_solver::assembly::{RotaryInertia, Store};
+    let text = r#"[structure]
+mesh = { generator = "rectangle", lx = 1.0, ly = 1.0, nx = 6, ny = 4 }
+material = { e = 1e6, nu = 0.3, rho = 1.0 }
+element = "shell"
+thickness = 0.1
+integrator = "newmark"
+dt = 1e-3
+t_end = 1e-2
+"#;
+    let case = Case::parse(text, Path::new("case.toml"), &[]).unwrap();
+    let s = structure_solver::build::build(&case, RotaryInertia::Physical).unwrap();
+    let (t, x0) = (s.model.topology(), s.model.initial_positions());
+    let (nx, ny) = (6, 4);
+    assert_eq!(t.nodes().len(), (nx + 1) * (ny + 1));
+    let mut moved = 0;
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let id = (j * (nx + 1) + i) as u64;
+            let slot = t.nodes().slot(id).expect("every user id has a slot");
+            moved += usize::from(slot as u64 != id);
+            assert_eq!(t.nodes().id(slot), Some(id));
+            assert_eq!(s.mesh.node_id(slot), id, "the mesh and the model agree");
+            let p = x0[slot];
+            assert!((p.x - i as f64 / nx as f64).abs() < 1e-15, "node {id} at {p:?}");
+            assert!((p.y - j as f64 / ny as f64).abs() < 1e-15, "node {id} at {p:?}");
+        }
+    }
+    assert!(moved > 0, "the renumbering moved nodes");
+    let mut moved = 0;
+    for j in 0..ny {
+        for i in 0..nx {
+            let id = (j * nx + i) as u64;
+            let c = t.elements().slot(id).expect("every element id has a slot");
+            moved += usize::from(c as u64 != id);
+            let corner = |i: usize, j: usize| (j * (nx + 1) + i) as u64;
+            let want = [corner(i, j), corner(i + 1, j), corner(i + 1, j + 1), corner(i, j + 1)];
+            let nodes: Vec<u64> = match t.store(c) {
+                Some(Store::Element(e)) => s.model.elements()[e].nodes.clone(),
+                other => panic!("element {id}: stored as {other:?}"),
+            }
+            .iter()
+            .map(|&n| t.nodes().id(n).unwrap())
+            .collect();
+            assert_eq!(nodes, want, "element {id} (slot {c})");
+        }
+    }
+    assert!(moved > 0, "the renumbering moved cells");
+}

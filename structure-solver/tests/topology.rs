@@ -29,7 +29,7 @@ const LENGTH: f64 = 0.2;
 
 /// Cells of even index are BT4 shells, odd ones MITC4 J2 shells.
 fn part(c: usize) -> Part {
-    if c % 2 == 0 {
+    if c.is_multiple_of(2) {
         Part::Bt4(SEC, Some(YIELD))
     } else {
         Part::ShellJ2(SEC, YIELD)

@@ -3,8 +3,9 @@
 //! stored, and the version counter of run-time changes (DESIGN §6, "ready for coupling and
 //! fracture"; the phantom elements of thesis §3.5, Fig. 3.2, are added through it).
 //!
-//! A model is built with ids equal to slots; the mesh builder may give the user's ids
-//! ([`FeModel::set_ids`]) after renumbering storage for locality. Elements are named by the
+//! A model is built with ids equal to slots; the case build (`crate::build`) gives the user's
+//! ids ([`FeModel::set_ids`]: gmsh node tags, else the input numbers) after renumbering
+//! storage for locality. Elements are named by the
 //! slot of their mesh cell: slot `c` is either a corotated/solid element or a BT4 shell.
 
 use std::collections::HashMap;

@@ -158,3 +158,21 @@ impl<const N: usize> Real for Lanes<N> {
         m.iter().fold(0, |acc, &v| acc | v) != 0
     }
 }
+
+/// Eight lanes read from and written to arrays: the blocks of the element kernels, as
+/// [`Lanes`] or as vector registers of one instruction set (`lanes_x86`).
+pub trait Block8: Real {
+    fn from_array(a: [f64; 8]) -> Self;
+    fn to_array(self) -> [f64; 8];
+}
+
+impl Block8 for Lanes<8> {
+    #[inline(always)]
+    fn from_array(a: [f64; 8]) -> Self {
+        Lanes(a)
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f64; 8] {
+        self.0
+    }
+}

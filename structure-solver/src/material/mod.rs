@@ -8,6 +8,8 @@
 pub mod elastic;
 pub mod j2;
 pub mod lanes;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod lanes_x86;
 pub mod thickness;
 
 pub use elastic::Elastic;

@@ -84,7 +84,9 @@ impl Dynamic<'_> {
                     .with_context(|| format!("step {n} (t = {:e})", im.state.t + step))?;
                 self.finite(model, &mut disp, (&im.state.v, &im.state.a, None), im.state.t)?;
                 self.after_step(model, &im.state, step)?;
-                if self.checkpoint_every > 0 && self.reached.steps % self.checkpoint_every == 0 {
+                if self.checkpoint_every > 0
+                    && self.reached.steps.is_multiple_of(self.checkpoint_every)
+                {
                     im.forget_factor(); // a restart from this checkpoint starts afresh too
                 }
             }
@@ -147,7 +149,7 @@ impl Dynamic<'_> {
         self.output
             .write(model, Some(model), &d.v, (steps, d.t, step), last)
             .with_context(|| format!("step {steps} of {:.3e} s", self.dt))?;
-        if self.checkpoint_every > 0 && steps % self.checkpoint_every == 0 {
+        if self.checkpoint_every > 0 && steps.is_multiple_of(self.checkpoint_every) {
             write_checkpoint(self.dir, model, d, steps, self.dt)?;
         }
         self.timers.add_since(bucket::OUTPUT, t0);

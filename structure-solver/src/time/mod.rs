@@ -42,7 +42,7 @@ pub enum ResizeError {
 impl Dynamics {
     /// Appends nodes with velocities `v` and accelerations `a`, 6 per node.
     pub fn push_nodes(&mut self, v: &[f64], a: &[f64]) -> Result<(), ResizeError> {
-        if v.len() % 6 != 0 {
+        if !v.len().is_multiple_of(6) {
             return Err(ResizeError::Length {
                 what: "velocity",
                 got: v.len(),

@@ -11,17 +11,19 @@
 //! thread the blocks add their forces to the nodes as they go, in ascending element order: the
 //! same sums without the work array.
 //!
-//! The vector width is chosen at run time ([`SimdPath`]): the block loop is compiled for
-//! AVX-512 (x86-64-v4), AVX2 + FMA (x86-64-v3) and the baseline (SSE2) through `pulp`, and
-//! the widest the processor has runs. The kernel never asks for fused multiply-adds, so every
-//! path does the same IEEE operations and gives the same bits.
+//! The vector width is chosen at run time ([`SimdPath`], detected through `pulp`): the block
+//! loop is compiled in functions of the AVX-512 (x86-64-v4) and AVX2 + FMA (x86-64-v3)
+//! instruction sets on the lanes of `material::lanes_x86` (one or two registers per block),
+//! and for the baseline (SSE2) on [`Lanes`]; the widest the processor has runs. The kernel
+//! never asks for fused multiply-adds, so every path does the same IEEE operations and gives
+//! the same bits.
 
 use rayon::prelude::*;
 
-use super::kernel::{element_block, BlockState, Constants, V};
+use super::kernel::{element_block, BlockState, Constants};
 use super::{LANES, N_HOURGLASS, N_STRESS};
 use crate::elements::incidence::Incidence;
-use crate::material::lanes::{Lanes, Real};
+use crate::material::lanes::{Block8, Lanes};
 
 /// Blocks of elements per task of the first phase.
 pub const BLOCKS_PER_TASK: usize = 16;
@@ -68,19 +70,46 @@ impl SimdPath {
         }
     }
 
-    /// Runs `op` compiled for this path; `None` when the processor lacks it.
-    pub(super) fn run<Op: pulp::WithSimd>(self, op: Op) -> Option<Op::Output> {
-        use pulp::Simd;
+    /// Runs `op` compiled for this path, on its lanes; `None` when the processor lacks it.
+    pub(super) fn run<Op: BlockOp>(self, op: Op) -> Option<Op::Output> {
+        if !self.is_supported() {
+            return None;
+        }
         match self {
+            // SAFETY: `is_supported` found x86-64-v4, the instruction set of `run_v4`.
             #[cfg(target_arch = "x86_64")]
-            SimdPath::Avx512 => pulp::x86::V4::try_new().map(|s| Simd::vectorize(s, op)),
+            SimdPath::Avx512 => Some(unsafe { run_v4(op) }),
+            // SAFETY: `is_supported` found x86-64-v3, the instruction set of `run_v3`.
             #[cfg(target_arch = "x86_64")]
-            SimdPath::Avx2Fma => pulp::x86::V3::try_new().map(|s| Simd::vectorize(s, op)),
-            SimdPath::Scalar => Some(Simd::vectorize(pulp::Scalar::new(), op)),
+            SimdPath::Avx2Fma => Some(unsafe { run_v3(op) }),
+            SimdPath::Scalar => Some(op.run::<Lanes<LANES>>()),
             #[allow(unreachable_patterns)]
             _ => None,
         }
     }
+}
+
+/// Work on blocks of [`LANES`] elements, compiled once per instruction set on its lanes.
+pub(super) trait BlockOp {
+    type Output;
+    fn run<R: Block8>(self) -> Self::Output;
+}
+
+/// `op` on one AVX-512 register per lane block, compiled for x86-64-v4 (the features `pulp`
+/// checks for it).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(
+    enable = "avx512f,avx512bw,avx512cd,avx512dq,avx512vl,avx2,avx,fma,bmi1,bmi2,lzcnt,popcnt"
+)]
+fn run_v4<Op: BlockOp>(op: Op) -> Op::Output {
+    op.run::<crate::material::lanes_x86::Avx512>()
+}
+
+/// `op` on two AVX2 registers per lane block, compiled for x86-64-v3.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx,fma,bmi1,bmi2,lzcnt,popcnt")]
+fn run_v3<Op: BlockOp>(op: Op) -> Op::Output {
+    op.run::<crate::material::lanes_x86::Avx2>()
 }
 
 /// The inputs every task reads.
@@ -121,17 +150,10 @@ struct BlockTask<'a> {
     forces: Sink<'a>,
 }
 
-impl pulp::WithSimd for BlockTask<'_> {
+impl BlockOp for BlockTask<'_> {
     type Output = ();
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _: S) {
-        self.run();
-    }
-}
-
-impl BlockTask<'_> {
-    #[inline(always)]
-    fn run(mut self) {
+    fn run<R: Block8>(mut self) {
         let Shared { bt4, x_end, du } = *self.shared;
         let np = bt4.settings.rule.len();
         let ne = bt4.conn.len();
@@ -142,31 +164,32 @@ impl BlockTask<'_> {
             let valid = (ne - e0).min(LANES);
             // Gather: padded lanes repeat the block's last element.
             let el = |l: usize| e0 + l.min(valid - 1);
-            let mut xe = [[V::splat(0.0); 3]; 4];
+            let mut xe = [[[0.0; LANES]; 3]; 4];
             let mut xm = xe;
-            let mut dv = [[V::splat(0.0); 6]; 4];
+            let mut dv = [[[0.0; LANES]; 6]; 4];
             for l in 0..LANES {
                 let c = &bt4.conn[el(l)];
                 for i in 0..4 {
                     let n = c[i] as usize;
                     let (p, d) = (&x_end[n], &du[6 * n..6 * n + 6]);
                     for k in 0..3 {
-                        xe[i][k].0[l] = p[k];
-                        xm[i][k].0[l] = p[k] - 0.5 * d[k];
+                        xe[i][k][l] = p[k];
+                        xm[i][k][l] = p[k] - 0.5 * d[k];
                     }
                     for k in 0..6 {
-                        dv[i][k].0[l] = d[k];
+                        dv[i][k][l] = d[k];
                     }
                 }
             }
-            let h = Lanes(std::array::from_fn(|l| bt4.thickness[el(l)]));
+            let (xe, xm, dv) = (lanes(xe), lanes(xm), lanes(dv));
+            let h = R::from_array(std::array::from_fn(|l| bt4.thickness[el(l)]));
             let m0 = bt4.material_of[e0];
             let mat = if (0..valid).all(|l| bt4.material_of[e0 + l] == m0) {
                 Constants::splat(&bt4.constants[m0 as usize])
             } else {
                 Constants::gather(|l| &bt4.constants[bt4.material_of[el(l)] as usize])
             };
-            let fe = element_block(
+            let fe: [[R; 6]; 4] = element_block(
                 &mat,
                 bt4.settings,
                 &xe,
@@ -182,6 +205,13 @@ impl BlockTask<'_> {
                     hg_new: &mut self.hg_new[j * nh..(j + 1) * nh],
                 },
             );
+            let mut out = [[[0.0; LANES]; 6]; 4];
+            for i in 0..4 {
+                for d in 0..6 {
+                    out[i][d] = fe[i][d].to_array();
+                }
+            }
+            let fe = out;
             match &mut self.forces {
                 Sink::Rows(rows) => {
                     let n = LANES * F_PER_ELEMENT;
@@ -189,7 +219,7 @@ impl BlockTask<'_> {
                     for l in 0..LANES {
                         for i in 0..4 {
                             for d in 0..6 {
-                                out[(l * 4 + i) * 6 + d] = fe[i][d].0[l];
+                                out[(l * 4 + i) * 6 + d] = fe[i][d][l];
                             }
                         }
                     }
@@ -199,7 +229,7 @@ impl BlockTask<'_> {
                         for (i, &n) in bt4.conn[e0 + l].iter().enumerate() {
                             let fnode = &mut f[6 * n as usize..6 * n as usize + 6];
                             for d in 0..6 {
-                                fnode[d] += fe[i][d].0[l];
+                                fnode[d] += fe[i][d][l];
                             }
                         }
                     }
@@ -207,6 +237,18 @@ impl BlockTask<'_> {
             }
         }
     }
+}
+
+/// Lane arrays `[node][component][lane]` as blocks.
+#[inline(always)]
+pub(super) fn lanes<R: Block8, const C: usize>(a: [[[f64; LANES]; C]; 4]) -> [[R; C]; 4] {
+    let mut out = [[R::splat(0.0); C]; 4];
+    for i in 0..4 {
+        for k in 0..C {
+            out[i][k] = R::from_array(a[i][k]);
+        }
+    }
+    out
 }
 
 /// Work arrays of the loop.

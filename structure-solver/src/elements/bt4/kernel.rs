@@ -4,10 +4,8 @@
 
 use super::{Bt4Settings, LANES, N_HOURGLASS, N_STRESS};
 use crate::elements::section::SHEAR_FACTOR;
-use crate::material::lanes::{Lanes, Real};
+use crate::material::lanes::{Block8, Real};
 use crate::material::{return_plane_stress_with, PlaneStressConstants, J2};
-
-pub(super) type V = Lanes<LANES>;
 
 /// Geometry of an element (block) in its corotated frame.
 pub(super) struct Frame<R> {
@@ -28,6 +26,11 @@ fn cross<R: Real>(a: [R; 3], b: [R; 3]) -> [R; 3] {
 }
 
 #[inline(always)]
+fn sub<R: Real>(a: [R; 3], b: [R; 3]) -> [R; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
 fn dot<R: Real>(a: [R; 3], b: [R; 3]) -> R {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -41,14 +44,18 @@ fn normalize<R: Real>(a: [R; 3]) -> [R; 3] {
 /// Corotated frame, projected local coordinates and the one-point `b = ∂N/∂x̂` at the centre.
 #[inline(always)]
 pub(super) fn frame<R: Real>(x: &[[R; 3]; 4]) -> Frame<R> {
-    let sub = |a: [R; 3], b: [R; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let e3 = normalize(cross(sub(x[2], x[0]), sub(x[3], x[1])));
     let x21 = sub(x[1], x[0]);
     let d = dot(x21, e3);
     let e1 = normalize([x21[0] - d * e3[0], x21[1] - d * e3[1], x21[2] - d * e3[2]]);
     let e2 = cross(e3, e1);
     let quarter = R::splat(0.25);
-    let c: [R; 3] = std::array::from_fn(|k| (x[0][k] + x[1][k] + x[2][k] + x[3][k]) * quarter);
+    // Functions and loops rather than closures over lanes: a closure is compiled apart from
+    // the instruction set of the kernel, so its vector operations may stay calls.
+    let mut c = [R::splat(0.0); 3];
+    for k in 0..3 {
+        c[k] = (x[0][k] + x[1][k] + x[2][k] + x[3][k]) * quarter;
+    }
     let mut lx = [R::splat(0.0); 4];
     let mut ly = lx;
     let mut lz = lx;
@@ -103,14 +110,14 @@ impl Constants<f64> {
     }
 }
 
-impl Constants<V> {
+impl<R: Block8> Constants<R> {
     /// Lane `l` takes the constants `of(l)`.
     #[inline(always)]
     pub fn gather<'a>(of: impl Fn(usize) -> &'a Constants<f64>) -> Self {
         let cs: [&Constants<f64>; LANES] = std::array::from_fn(of);
         macro_rules! lanes {
             ($($f:ident).+) => {
-                Lanes(std::array::from_fn(|l| cs[l].$($f).+))
+                R::from_array(std::array::from_fn(|l| cs[l].$($f).+))
             };
         }
         Constants {
@@ -135,13 +142,13 @@ impl Constants<V> {
 }
 
 #[inline(always)]
-fn load(s: &[f64], i: usize) -> V {
-    Lanes(s[i * LANES..(i + 1) * LANES].try_into().expect("lane slice"))
+fn load<R: Block8>(s: &[f64], i: usize) -> R {
+    R::from_array(s[i * LANES..(i + 1) * LANES].try_into().expect("lane slice"))
 }
 
 #[inline(always)]
-fn store(s: &mut [f64], i: usize, v: V) {
-    s[i * LANES..(i + 1) * LANES].copy_from_slice(&v.0);
+fn store<R: Block8>(s: &mut [f64], i: usize, v: R) {
+    s[i * LANES..(i + 1) * LANES].copy_from_slice(&v.to_array());
 }
 
 /// The committed (read) and trial (written) state of one block.
@@ -157,7 +164,7 @@ pub(super) struct BlockState<'a> {
 /// One block: strain increments at the mid geometry, stress update at every thickness point,
 /// resultants, hourglass, nodal forces and moments in the end geometry (global frame).
 #[inline(always)]
-pub(super) fn element_block(
+pub(super) fn element_block<V: Block8>(
     mat: &Constants<V>,
     set: &Bt4Settings,
     x_end: &[[V; 3]; 4],
@@ -214,19 +221,19 @@ pub(super) fn element_block(
         let de = [em[0] + z * kap[0], em[1] + z * kap[1], em[2] + z * kap[2]];
         let s = p * N_STRESS;
         let trial = [
-            load(st.stress_old, s) + c00 * de[0] + c01 * de[1],
-            load(st.stress_old, s + 1) + c01 * de[0] + c00 * de[1],
-            load(st.stress_old, s + 2) + c22 * de[2],
+            load::<V>(st.stress_old, s) + c00 * de[0] + c01 * de[1],
+            load::<V>(st.stress_old, s + 1) + c01 * de[0] + c00 * de[1],
+            load::<V>(st.stress_old, s + 2) + c22 * de[2],
         ];
         let r = return_plane_stress_with(
             &mat.ret,
             trial,
-            load(st.alpha_old, p),
+            load::<V>(st.alpha_old, p),
             set.newton,
             set.return_tol,
         );
-        let syz = load(st.stress_old, s + 3) + gk * gyz;
-        let szx = load(st.stress_old, s + 4) + gk * gxz;
+        let syz = load::<V>(st.stress_old, s + 3) + gk * gyz;
+        let szx = load::<V>(st.stress_old, s + 4) + gk * gxz;
         for k in 0..3 {
             store(st.stress_new, s + k, r.sigma[k]);
         }
@@ -258,10 +265,14 @@ pub(super) fn element_block(
     }
 
     // --- Hourglass control (Flanagan-Belytschko), stiffness form, in the end frame.
-    let hv = [1.0, -1.0, 1.0, -1.0].map(V::splat);
+    let (one, minus_one) = (V::splat(1.0), V::splat(-1.0));
+    let hv = [one, minus_one, one, minus_one];
     let hx = hv[0] * fe.x[0] + hv[1] * fe.x[1] + hv[2] * fe.x[2] + hv[3] * fe.x[3];
     let hy = hv[0] * fe.y[0] + hv[1] * fe.y[1] + hv[2] * fe.y[2] + hv[3] * fe.y[3];
-    let g: [V; 4] = std::array::from_fn(|i| quarter * (hv[i] - hx * fe.b1[i] - hy * fe.b2[i]));
+    let mut g = [zero; 4];
+    for i in 0..4 {
+        g[i] = quarter * (hv[i] - hx * fe.b1[i] - hy * fe.b2[i]);
+    }
     let mut bb = zero;
     for i in 0..4 {
         bb += fe.b1[i] * fe.b1[i] + fe.b2[i] * fe.b2[i];
@@ -288,7 +299,7 @@ pub(super) fn element_block(
     let kh = [k_mem, k_mem, k_w, k_rot, k_rot];
     let mut qh = [zero; N_HOURGLASS];
     for k in 0..N_HOURGLASS {
-        qh[k] = load(st.hg_old, k) + kh[k] * qd[k];
+        qh[k] = load::<V>(st.hg_old, k) + kh[k] * qd[k];
         store(st.hg_new, k, qh[k]);
     }
     for i in 0..4 {

@@ -20,8 +20,9 @@
 //! nodal forces in the end geometry.
 //!
 //! Elements are evaluated in blocks of [`LANES`] with the kernel (`kernel`) written once over
-//! [`Real`](crate::material::lanes::Real), so the compiler vectorises across elements; the loop
-//! (`forces`) runs over threads and picks the vector width at run time. Per-point state lives
+//! [`Real`](crate::material::lanes::Real), each operation one across the elements of a block
+//! (vector registers on x86-64); the loop (`forces`) runs over threads and picks the vector
+//! width at run time. Per-point state lives
 //! in flat arrays `[block][point][component][lane]`. State is double-buffered: a step reads the
 //! committed state and writes the trial state; `commit` swaps them. Each element has its own
 //! material (an index into the part's list), so a block may mix materials.

@@ -6,11 +6,11 @@
 
 use rayon::prelude::*;
 
-use super::forces::{Bt4View, SimdPath};
-use super::kernel::{frame, V};
+use super::forces::{lanes, BlockOp, Bt4View, SimdPath};
+use super::kernel::frame;
 use super::{BLOCKS_PER_TASK, LANES};
 use crate::elements::section::SHEAR_FACTOR;
-use crate::material::lanes::{Lanes, Real};
+use crate::material::lanes::{Block8, Real};
 use crate::material::J2;
 
 /// The material constants of the bound: plate wave speed `c`, `12 κ G`, `4 E` and `ρ`.
@@ -44,14 +44,17 @@ pub(super) fn bounds<R: Real>(
     scaled: bool,
 ) -> (R, R) {
     let a = frame(x).area;
-    let d = |i: usize, j: usize| {
-        let s: [R; 3] = std::array::from_fn(|k| x[i][k] - x[j][k]);
-        (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
-    };
-    let l = a / d(0, 2).max(d(1, 3));
+    let l = a / distance(&x[0], &x[2]).max(distance(&x[1], &x[3]));
     let a_rot = if scaled { a } else { R::splat(0.0) };
     let w2 = (c.s12 + c.e4 * h * h / a) / (c.rho * (h * h + a_rot));
     (l / c.wave, R::splat(2.0) / w2.sqrt())
+}
+
+/// `|a - b|`.
+#[inline(always)]
+fn distance<R: Real>(a: &[R; 3], b: &[R; 3]) -> R {
+    let s = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt()
 }
 
 /// The blocks of one task.
@@ -62,17 +65,10 @@ struct BoundTask<'a> {
     blocks: std::ops::Range<usize>,
 }
 
-impl pulp::WithSimd for BoundTask<'_> {
+impl BlockOp for BoundTask<'_> {
     type Output = f64;
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _: S) -> f64 {
-        self.run()
-    }
-}
-
-impl BoundTask<'_> {
-    #[inline(always)]
-    fn run(self) -> f64 {
+    fn run<R: Block8>(self) -> f64 {
         let (bt4, x) = (self.bt4, self.x);
         let ne = bt4.conn.len();
         let scaled = bt4.settings.rotary == super::RotaryInertia::Scaled;
@@ -81,28 +77,30 @@ impl BoundTask<'_> {
             let e0 = b * LANES;
             let valid = (ne - e0).min(LANES);
             let el = |l: usize| e0 + l.min(valid - 1);
-            let mut xe = [[V::splat(0.0); 3]; 4];
+            let mut xe = [[[0.0; LANES]; 3]; 4];
             for l in 0..LANES {
                 let c = &bt4.conn[el(l)];
                 for i in 0..4 {
                     let p = &x[c[i] as usize];
                     for k in 0..3 {
-                        xe[i][k].0[l] = p[k];
+                        xe[i][k][l] = p[k];
                     }
                 }
             }
-            let h = Lanes(std::array::from_fn(|l| bt4.thickness[el(l)]));
+            let xe = lanes::<R, 3>(xe);
+            let h = R::from_array(std::array::from_fn(|l| bt4.thickness[el(l)]));
             let m: [&BoundConstants<f64>; LANES] =
                 std::array::from_fn(|l| &self.bounds[bt4.material_of[el(l)] as usize]);
             let c = BoundConstants {
-                wave: Lanes(std::array::from_fn(|l| m[l].wave)),
-                s12: Lanes(std::array::from_fn(|l| m[l].s12)),
-                e4: Lanes(std::array::from_fn(|l| m[l].e4)),
-                rho: Lanes(std::array::from_fn(|l| m[l].rho)),
+                wave: R::from_array(std::array::from_fn(|l| m[l].wave)),
+                s12: R::from_array(std::array::from_fn(|l| m[l].s12)),
+                e4: R::from_array(std::array::from_fn(|l| m[l].e4)),
+                rho: R::from_array(std::array::from_fn(|l| m[l].rho)),
             };
             let (t1, t2) = bounds(&xe, h, &c, scaled);
+            let (t1, t2) = (t1.to_array(), t2.to_array());
             for l in 0..valid {
-                dt = dt.min(t1.0[l].min(t2.0[l]));
+                dt = dt.min(t1[l].min(t2[l]));
             }
         }
         dt
