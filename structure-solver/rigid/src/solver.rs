@@ -5,8 +5,7 @@
 use crate::finite::{check_dofs, check_loads, At};
 use crate::model::Body;
 use crate::setup::Setup;
-use interface_protocol::case::Scheme;
-use interface_protocol::coupling::Staggered;
+use interface_protocol::coupling::{Oscillators, Staggered};
 use interface_protocol::endpoint::StructureEndpoint;
 use interface_protocol::io::checkpoint::Checkpoint;
 use interface_protocol::io::outdir::OutputDir;
@@ -20,7 +19,9 @@ pub const CHECKPOINT_PART: &str = "structure";
 /// The rigid structure's state.
 pub struct RigidSolver {
     pub body: Body,
-    pub state: Staggered,
+    /// The body's DOFs and their state (`u`, `v`, `a`), and the scheme's own state.
+    pub state: Oscillators,
+    pub scheme: Staggered,
     /// Scratch for reduced loads.
     load: Vec<f64>,
     /// Time the state `u`, `v`, `a` refers to.
@@ -46,14 +47,16 @@ impl RigidSolver {
     /// The solver of a case's setup, writing `structure_probes.csv` and checkpoints into `out`.
     pub fn new(setup: Setup, out: OutputDir) -> Result<RigidSolver, String> {
         let Setup { body, scheme, dt, t_end, probes_every, .. } = setup;
-        let mut state = Staggered::new(scheme, &body.u0, &body.v0);
+        let mut state = Oscillators::new(body.dynamics.clone(), &body.u0, &body.v0);
         body.impose(0.0, &mut state.u, &mut state.v, Some(&mut state.a));
+        let scheme = Staggered::new(scheme, body.u0.len());
         let probes = ProbeWriter::structure(out.path(), &[body.probe.as_str()])
             .map_err(|e| format!("cannot create the probe file: {e}"))?;
         Ok(RigidSolver {
             load: vec![0.0; body.dofs.len()],
             body,
             state,
+            scheme,
             t: 0.0,
             probes,
             probes_every,
@@ -70,7 +73,7 @@ impl RigidSolver {
 
     /// The stable coupling step of the scheme's structure integrator.
     pub fn dt_stable(&self) -> f64 {
-        crate::setup::dt_stable(self.state.scheme, &self.body)
+        crate::setup::dt_stable(self.scheme.scheme, &self.body)
     }
 
     /// Where a check of step `step` of length `dt` at time `t` happens.
@@ -80,8 +83,8 @@ impl RigidSolver {
 
     /// The kinematics to publish are finite.
     fn check_prediction(&self, at: At) -> Result<(), Failure> {
-        check_dofs(&self.body, "predicted displacement", &self.state.up, at)?;
-        check_dofs(&self.body, "predicted velocity", &self.state.vp, at)
+        check_dofs(&self.body, "predicted displacement", &self.scheme.up, at)?;
+        check_dofs(&self.body, "predicted velocity", &self.scheme.vp, at)
     }
 
     /// The state reached is finite.
@@ -93,10 +96,11 @@ impl RigidSolver {
 
     /// START with the generalized load F^0 in `self.load`; returns whether a prediction is due.
     fn start(&mut self, dt: f64) -> Result<bool, Failure> {
-        let publish = self.state.start(&self.body.dynamics, &self.load, dt);
+        let Ok(publish) = self.scheme.start(&mut self.state, &self.load, dt);
         let s = &mut self.state;
         self.body.impose(0.0, &mut s.u, &mut s.v, Some(&mut s.a));
-        self.body.impose(0.5 * dt, &mut s.up, &mut s.vp, None);
+        let p = &mut self.scheme;
+        self.body.impose(0.5 * dt, &mut p.up, &mut p.vp, None);
         self.check_state(self.at(0.0, 0, dt))?;
         self.check_prediction(self.at(0.5 * dt, 0, dt))?;
         Ok(publish)
@@ -111,22 +115,17 @@ impl RigidSolver {
         with_load: bool,
     ) -> Result<f64, Failure> {
         let load = with_load.then_some(self.load.as_slice());
-        self.state.predict(dt, load);
-        // The time the prediction stands for (CSS: the held state t^n).
-        let target = match self.state.scheme {
-            Scheme::Css => t_from,
-            Scheme::C0 => t_from + 1.5 * dt,
-            Scheme::A6 => t_from + 0.5 * dt,
-        };
-        let s = &mut self.state;
-        self.body.impose(target, &mut s.up, &mut s.vp, None);
+        self.scheme.predict(&mut self.state, dt, load);
+        let target = self.scheme.predicted_time(t_from, dt);
+        let p = &mut self.scheme;
+        self.body.impose(target, &mut p.up, &mut p.vp, None);
         self.check_prediction(self.at(target, step, dt))?;
         Ok(target)
     }
 
     /// CORRECT of step `step` with the generalized load in `self.load`; the state reaches `t_to`.
     fn correct(&mut self, step: u64, t_to: f64, dt: f64) -> Result<(), Failure> {
-        self.state.correct(&self.body.dynamics, &self.load, dt);
+        let Ok(()) = self.scheme.correct(&mut self.state, &self.load, dt);
         let s = &mut self.state;
         self.body.impose(t_to, &mut s.u, &mut s.v, Some(&mut s.a));
         self.check_state(self.at(t_to, step, dt))?;
@@ -151,7 +150,7 @@ impl RigidSolver {
             let t_from = step as f64 * dt;
             let t_to = if step + 1 == n_steps { t_end } else { t_from + dt };
             self.load.fill(0.0);
-            let with_load = self.state.predict_reads_load(step);
+            let with_load = self.scheme.predict_reads_load(step);
             self.predict(step, t_from, t_to - t_from, with_load)?;
             self.correct(step, t_to, t_to - t_from)?;
             if (step + 1) % self.probes_every == 0 || step + 1 == n_steps {
@@ -171,7 +170,7 @@ impl RigidSolver {
         predicted: bool,
     ) -> Result<(), Failure> {
         let (u, v) = if predicted {
-            (&self.state.up, &self.state.vp)
+            (&self.scheme.up, &self.scheme.vp)
         } else {
             (&self.state.u, &self.state.v)
         };
@@ -224,7 +223,7 @@ impl Handler<StructureEndpoint> for RigidSolver {
                 }
             }
             scheme_phase::PREDICT => {
-                let with_load = self.state.predict_reads_load(c.step);
+                let with_load = self.scheme.predict_reads_load(c.step);
                 if with_load {
                     self.read_loads(ep, self.at(c.t_from, c.step, dt))?;
                 }
@@ -416,6 +415,7 @@ mod coupled_tests {
     //! sequence, an analytic piston face answers in a fluid thread, and the piston's motion is
     //! compared with the closed form of m u'' + ρ0 c0 A u' + k u = -A p0.
     use super::*;
+    use interface_protocol::case::Scheme;
     use interface_protocol::case::Case;
     use interface_protocol::endpoint::{ControlPort, FluidEndpoint, LauncherLink, Timeouts};
     use interface_protocol::handshake::HelloInfo;

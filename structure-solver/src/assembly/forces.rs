@@ -273,6 +273,16 @@ impl Model for FeModel {
 }
 
 impl FeModel {
+    /// The displacement as 6 values per node, rotations zero (the kinematics a coupled
+    /// structure publishes).
+    pub fn displacement_dofs(&self, out: &mut [f64]) {
+        out.fill(0.0);
+        for (n, o) in out.chunks_exact_mut(6).enumerate() {
+            let d = self.trial.x[n] - self.x0[n];
+            o[..3].copy_from_slice(&[d.x, d.y, d.z]);
+        }
+    }
+
     /// The tangent of the elements; explicit shells add nothing (`has_tangent` is then `false`).
     pub(super) fn element_tangent(&self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
         out.clear();

@@ -6,7 +6,9 @@
 //! `phi = 1`. Every step the structure checks its state finite before it writes or publishes
 //! anything (`state_check`, as a run alone does) and fails the step naming the node and dof.
 //! The fluid's nodal loads are added to
-//! the external force of the wet nodes' translations. Integrators per scheme: CSS and C0 central
+//! the external force of the wet nodes' translations. The schemes are sequenced by
+//! [`interface_protocol::coupling::Staggered`], the one implementation every structure
+//! participant uses, over the model as its [`Dynamics`] ([`fe_dynamics`]): CSS and C0 central
 //! differences (C0: `F^{n+1} = (F^{n+1/2} + F^{n+3/2})/2` in `a^{n+1}`), A6 the implicit
 //! midpoint rule with `F^{n+1/2}` held over the step.
 
@@ -14,10 +16,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail};
 use interface_protocol::case::{Case, Integrator, Scheme};
-use interface_protocol::coupling::{
-    a6_acceleration_estimate, a6_prediction, c0_load_average, c0_prediction, c0_start_prediction,
-    kick,
-};
+use interface_protocol::coupling::{Dynamics, Staggered};
 use interface_protocol::endpoint::{StructureEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
 use interface_protocol::io::checkpoint::Checkpoint;
@@ -28,41 +27,28 @@ use interface_protocol::participant::{failure_code, serve, Failure, Handler, Pro
 
 use interface_protocol::io::progress::Progress as Bar;
 
-use crate::assembly::{FeModel, RotaryInertia};
+use crate::assembly::RotaryInertia;
 use crate::build::{build, field_error, need, section, Structure};
 use crate::model::Model;
 use crate::output::FieldOutput;
 use crate::restart::{save_dynamics, save_state, PART};
 use crate::state_check::{check_dofs, check_state};
-use crate::time::{critical_dt, CentralDifference, Implicit, ImplicitScheme, StableStep};
+use crate::time::{critical_dt, StableStep};
+
+pub mod fe_dynamics;
 
 pub use crate::wet::{wet_surface, WetSurface};
-
-/// The integrator of the scheme, created at START from the load `F^0`.
-enum Stepper {
-    Explicit(CentralDifference),
-    Midpoint(Implicit),
-}
-
-/// Velocity per dof: the integrator's, or `v0` before START.
-fn velocity<'a>(stepper: &'a Option<Stepper>, v0: &'a [f64]) -> &'a [f64] {
-    match stepper {
-        Some(Stepper::Explicit(cd)) => &cd.state.v,
-        Some(Stepper::Midpoint(im)) => &im.state.v,
-        None => v0,
-    }
-}
+use fe_dynamics::FeDynamics;
 
 /// The structure through the coupling sequence.
 pub struct Participant {
-    scheme: Scheme,
-    model: FeModel,
+    /// The model and its integrator, and the scheme's own state.
+    dynamics: FeDynamics,
+    scheme: Staggered,
     wet: WetSurface,
     /// Reference positions of all nodes, and the user's id of each (for messages).
     x0: Vec<[f64; 3]>,
     node_ids: Vec<u64>,
-    v0: Vec<f64>,
-    stepper: Option<Stepper>,
     /// Length of the first coupling step (START carries none), and the end of the run (the last
     /// state is always probed).
     first_dt: f64,
@@ -76,14 +62,8 @@ pub struct Participant {
     checkpoints: PathBuf,
     /// The fluid load just read, 6 per node (translations of wet nodes only).
     load: Vec<f64>,
-    /// C0: `F^{n+1/2}` and `v^{n-1/2}`; A6: `â^n`; scratch for loads and velocities.
-    f_half: Vec<f64>,
-    v_half_prev: Vec<f64>,
-    a_hat: Vec<f64>,
-    scratch: Vec<f64>,
-    /// Kinematics to publish, 6 per node (`up` displacements, `vp` velocities).
-    up: Vec<f64>,
-    vp: Vec<f64>,
+    /// The current displacement, 6 per node (the state `Init` publishes).
+    current: Vec<f64>,
     disp: Vec<[f64; 3]>,
     probes: ProbeWriter,
     probe_nodes: Vec<usize>,
@@ -181,12 +161,11 @@ impl Participant {
             fields_every: case.output.fields_every,
             fields_t: f64::NAN,
             bar: Some(Bar::new(case.coupling.t_end, quiet)),
-            scheme,
+            dynamics: FeDynamics::new(model, scheme, v0),
+            scheme: Staggered::new(scheme, n),
             wet,
             x0: mesh.nodes.clone(),
             node_ids: (0..mesh.nodes.len()).map(|i| mesh.node_id(i)).collect(),
-            v0,
-            stepper: None,
             first_dt: case.coupling.dt.min(case.coupling.t_end),
             t_end: case.coupling.t_end,
             dt_stable,
@@ -195,17 +174,11 @@ impl Participant {
             steps: 0,
             checkpoints: dir.path().join("checkpoints"),
             load: vec![0.0; n],
-            f_half: vec![0.0; n],
-            v_half_prev: vec![0.0; n],
-            a_hat: vec![0.0; n],
-            scratch: vec![0.0; n],
-            up: vec![0.0; n],
-            vp: vec![0.0; n],
+            current: vec![0.0; n],
             disp: vec![[0.0; 3]; mesh.nodes.len()],
             probe_nodes: s.probes.iter().map(|p| mesh.nearest_node(p.point)).collect(),
             probes,
             probes_every: s.output_every.unwrap_or(1).max(1),
-            model,
         })
     }
 
@@ -218,34 +191,20 @@ impl Participant {
         }
     }
 
-    /// Velocity per dof at the current state.
-    fn velocity(&self) -> &[f64] {
-        velocity(&self.stepper, &self.v0)
-    }
-
-    /// The model's displacement as 6 values per node (rotations zero) into `up`.
-    fn displacement_into_up(&mut self) {
-        self.model.displacement(&mut self.disp);
-        self.up.fill(0.0);
-        for (i, d) in self.disp.iter().enumerate() {
-            self.up[6 * i..6 * i + 3].copy_from_slice(d);
-        }
-    }
-
-    /// Publishes `x = X + up`, `v = vp` on the wet nodes for time `t`.
+    /// Publishes `x = X + u`, `v` (6 values per node) on the wet nodes for time `t`.
     fn publish(
         &self,
         ep: &mut StructureEndpoint,
-        step: u64,
-        t: f64,
-        dt: f64,
+        (step, t, dt): (u64, f64, f64),
+        u: &[f64],
+        v: &[f64],
     ) -> Result<(), Failure> {
         let header = StepHeader { step, time: t, dt, topology_version: 1, count: 0 };
-        let (wet, x0, up, vp) = (&self.wet.nodes, &self.x0, &self.up, &self.vp);
+        let (wet, x0) = (&self.wet.nodes, &self.x0);
         let ids = &self.node_ids;
         let id = |i: usize| ids[i];
-        check_dofs("displacement sent", up, &id)
-            .and_then(|()| check_dofs("velocity sent", vp, &id))
+        check_dofs("displacement sent", u, &id)
+            .and_then(|()| check_dofs("velocity sent", v, &id))
             .map_err(|e| {
                 Failure::new(
                     failure_code::SOLVER,
@@ -255,26 +214,21 @@ impl Participant {
         ep.publish_kinematics(header, wet.len(), |out: &mut [NodeState]| {
             for (o, &n) in out.iter_mut().zip(wet) {
                 for k in 0..3 {
-                    o.x[k] = x0[n][k] + up[6 * n + k];
-                    o.v[k] = vp[6 * n + k];
+                    o.x[k] = x0[n][k] + u[6 * n + k];
+                    o.v[k] = v[6 * n + k];
                 }
             }
         })?;
         Ok(())
     }
 
-    /// Publishes the current state `(u, v)`.
-    fn publish_current(
-        &mut self,
+    /// Publishes the scheme's prediction (`up`, `vp`).
+    fn publish_prediction(
+        &self,
         ep: &mut StructureEndpoint,
-        step: u64,
-        t: f64,
-        dt: f64,
+        at: (u64, f64, f64),
     ) -> Result<(), Failure> {
-        self.displacement_into_up();
-        let v = velocity(&self.stepper, &self.v0);
-        self.vp.copy_from_slice(v);
-        self.publish(ep, step, t, dt)
+        self.publish(ep, at, &self.scheme.up, &self.scheme.vp)
     }
 
     /// Reads the fluid's loads into `self.load` (translations of the wet nodes).
@@ -306,34 +260,10 @@ impl Participant {
     /// START: `a^0` from `F^0`; C0 publishes the prediction for `t^{1/2}`.
     fn start(&mut self, ep: &mut StructureEndpoint) -> Result<(), Failure> {
         self.read_loads(ep)?;
-        let v0 = self.v0.clone();
         let dt = self.first_dt;
-        match self.scheme {
-            Scheme::A6 => {
-                let im = Implicit::new(
-                    &mut self.model,
-                    ImplicitScheme::Midpoint,
-                    0.0,
-                    v0,
-                    Some(&self.load),
-                );
-                self.a_hat.copy_from_slice(&im.state.a);
-                self.stepper = Some(Stepper::Midpoint(im));
-            }
-            Scheme::Css | Scheme::C0 => {
-                let cd = CentralDifference::new(&mut self.model, 0.0, v0, Some(&self.load));
-                if self.scheme == Scheme::C0 {
-                    let s = &cd.state;
-                    kick(&s.v, &s.a, -0.5 * dt, &mut self.v_half_prev);
-                    self.displacement_into_up();
-                    self.scratch.copy_from_slice(&self.up);
-                    c0_start_prediction(&self.scratch, &s.v, &s.a, dt, &mut self.up, &mut self.vp);
-                    self.stepper = Some(Stepper::Explicit(cd));
-                    self.publish(ep, 0, 0.5 * dt, dt)?;
-                } else {
-                    self.stepper = Some(Stepper::Explicit(cd));
-                }
-            }
+        let solver = |e: String| Failure::new(failure_code::SOLVER, format!("START: {e}"));
+        if self.scheme.start(&mut self.dynamics, &self.load, dt).map_err(solver)? {
+            self.publish_prediction(ep, (0, 0.5 * dt, dt))?;
         }
         Ok(())
     }
@@ -346,47 +276,20 @@ impl Participant {
         t_from: f64,
         dt: f64,
     ) -> Result<(), Failure> {
-        match (self.scheme, self.stepper.as_mut()) {
-            (Scheme::Css, Some(_)) => self.publish_current(ep, n, t_from, dt),
-            (Scheme::C0, Some(Stepper::Explicit(_))) => {
-                if n == 0 {
-                    self.read_loads(ep)?;
-                    self.f_half.copy_from_slice(&self.load);
-                }
-                let Some(Stepper::Explicit(cd)) = self.stepper.as_mut() else { unreachable!() };
-                cd.advance_positions(&mut self.model, dt);
-                self.displacement_into_up();
-                self.scratch.copy_from_slice(&self.up);
-                let Some(Stepper::Explicit(cd)) = self.stepper.as_ref() else { unreachable!() };
-                c0_prediction(
-                    &self.scratch,
-                    &cd.v_half,
-                    &self.v_half_prev,
-                    dt,
-                    &mut self.up,
-                    &mut self.vp,
-                );
-                self.publish(ep, n, t_from + 1.5 * dt, dt)
-            }
-            (Scheme::A6, Some(Stepper::Midpoint(_))) => {
-                self.displacement_into_up();
-                self.scratch.copy_from_slice(&self.up);
-                let Some(Stepper::Midpoint(im)) = self.stepper.as_ref() else { unreachable!() };
-                a6_prediction(
-                    &self.scratch,
-                    &im.state.v,
-                    &self.a_hat,
-                    dt,
-                    &mut self.up,
-                    &mut self.vp,
-                );
-                self.publish(ep, n, t_from + 0.5 * dt, dt)
-            }
-            _ => Err(Failure::new(
+        if self.dynamics.stepper.is_none() {
+            return Err(Failure::new(
                 failure_code::PROTOCOL,
                 format!("PREDICT of step {n} before START"),
-            )),
+            ));
         }
+        let load = if self.scheme.predict_reads_load(n) {
+            self.read_loads(ep)?;
+            Some(self.load.as_slice())
+        } else {
+            None
+        };
+        self.scheme.predict(&mut self.dynamics, dt, load);
+        self.publish_prediction(ep, (n, self.scheme.predicted_time(t_from, dt), dt))
     }
 
     /// CORRECT of step `n`: the structure reaches `t_to`.
@@ -398,40 +301,24 @@ impl Participant {
         dt: f64,
     ) -> Result<(), Failure> {
         self.read_loads(ep)?;
-        match self.stepper.as_mut() {
-            Some(Stepper::Explicit(cd)) if self.scheme == Scheme::Css => {
-                cd.step(&mut self.model, dt, Some(&self.load));
-            }
-            Some(Stepper::Explicit(cd)) => {
-                c0_load_average(&self.f_half, &self.load, &mut self.scratch);
-                cd.complete(&mut self.model, dt, Some(&self.scratch));
-                self.v_half_prev.copy_from_slice(&cd.v_half);
-                self.f_half.copy_from_slice(&self.load);
-            }
-            Some(Stepper::Midpoint(im)) => {
-                self.scratch.copy_from_slice(&im.state.v);
-                im.step(&mut self.model, dt, Some(&self.load)).map_err(|e| {
-                    Failure::new(failure_code::SOLVER, format!("step {n} to t = {t_to}: {e}"))
-                })?;
-                a6_acceleration_estimate(&im.state.v, &self.scratch, dt, &mut self.a_hat);
-            }
-            None => {
-                return Err(Failure::new(
-                    failure_code::PROTOCOL,
-                    format!("CORRECT of step {n} before START"),
-                ))
-            }
+        if self.dynamics.stepper.is_none() {
+            return Err(Failure::new(
+                failure_code::PROTOCOL,
+                format!("CORRECT of step {n} before START"),
+            ));
         }
+        self.scheme.correct(&mut self.dynamics, &self.load, dt).map_err(|e| {
+            Failure::new(failure_code::SOLVER, format!("step {n} to t = {t_to}: {e}"))
+        })?;
         self.check_state(n, t_to, dt)?;
         if let Some(rule) = self.stable_rule {
-            self.dt_stable = rule.at(&self.model);
+            self.dt_stable = rule.at(&self.dynamics.model);
         }
         self.t = t_to;
         self.steps = n + 1;
-        let (fields, model) = (self.fields.as_mut(), &self.model);
-        let v = velocity(&self.stepper, &self.v0);
+        let (fields, d) = (self.fields.as_mut(), &self.dynamics);
         if let Some(f) = fields {
-            f.gather(t_to, model, Some(model), v).map_err(|e| {
+            f.gather(t_to, &d.model, Some(&d.model), d.velocity()).map_err(|e| {
                 Failure::new(
                     failure_code::SOLVER,
                     format!("{e} (step {n}, Δt = {dt:.3e}, stable step {:.3e})", self.dt_stable),
@@ -452,14 +339,13 @@ impl Participant {
 
     /// The state after step `n` (to `t_to`), checked finite before anything is written.
     fn check_state(&mut self, n: u64, t_to: f64, dt: f64) -> Result<(), Failure> {
-        let (v, a, f_int) = match &self.stepper {
-            Some(Stepper::Explicit(cd)) => (&cd.state.v, &cd.state.a, Some(cd.internal_force())),
-            Some(Stepper::Midpoint(im)) => (&im.state.v, &im.state.a, None),
-            None => return Ok(()),
-        };
+        let d = &self.dynamics;
+        let Some(state) = d.state() else { return Ok(()) };
+        let (v, a, f_int) = (&state.v, &state.a, d.internal_force());
         let ids = &self.node_ids;
-        check_state(&self.model, &mut self.disp, (v, a, f_int), &|i| ids[i]).map_err(|e| {
-            let note = match unstable_coupling(dt, self.dt_stable, self.scheme) {
+        let scheme = self.scheme.scheme;
+        check_state(&d.model, &mut self.disp, (v, a, f_int), &|i| ids[i]).map_err(|e| {
+            let note = match unstable_coupling(dt, self.dt_stable, scheme) {
                 Some(m) => format!(" ({m})"),
                 None => String::new(),
             };
@@ -496,27 +382,23 @@ impl Participant {
     /// Writes `checkpoints/<tag>/structure.ckpt`: the model's state, velocities and
     /// accelerations, and the scheme's own state (C0: `F^{n+1/2}`, `v^{n-1/2}`; A6: `â^n`).
     fn write_checkpoint(&self, tag: &str) -> anyhow::Result<()> {
-        let Some(d) = (match &self.stepper {
-            Some(Stepper::Explicit(cd)) => Some(&cd.state),
-            Some(Stepper::Midpoint(im)) => Some(&im.state),
-            None => None,
-        }) else {
+        let Some(d) = self.dynamics.state() else {
             bail!("a checkpoint needs START first");
         };
         let mut ck = Checkpoint::new(self.steps, self.t);
-        save_state(&self.model, &mut ck)?;
+        save_state(&self.dynamics.model, &mut ck)?;
         save_dynamics(&mut ck, d)?;
-        ck.put("coupling.f_half", self.f_half.clone())?;
-        ck.put("coupling.v_half_prev", self.v_half_prev.clone())?;
-        ck.put("coupling.a_hat", self.a_hat.clone())?;
+        for (name, values) in self.scheme.history() {
+            ck.put(&format!("coupling.{name}"), values.to_vec())?;
+        }
         ck.write(&self.checkpoints, tag, PART)?;
         Ok(())
     }
 
     /// One row of `structure_probes.csv` at the current state.
     fn write_probes(&mut self) -> Result<(), Failure> {
-        self.model.displacement(&mut self.disp);
-        let v = self.velocity();
+        self.dynamics.model.displacement(&mut self.disp);
+        let v = self.dynamics.velocity();
         let mut row = Vec::with_capacity(6 * self.probe_nodes.len());
         for &p in &self.probe_nodes {
             row.extend_from_slice(&self.disp[p]);
@@ -528,16 +410,19 @@ impl Participant {
 
 impl Handler<StructureEndpoint> for Participant {
     fn init(&mut self, ep: &mut StructureEndpoint) -> Result<f64, Failure> {
-        if let Some(message) = unstable_coupling(self.first_dt, self.dt_stable, self.scheme) {
+        if let Some(message) = unstable_coupling(self.first_dt, self.dt_stable, self.scheme.scheme)
+        {
             return Err(Failure::new(failure_code::SOLVER, message));
         }
         let header = StepHeader { step: 0, time: 0.0, dt: 0.0, topology_version: 1, count: 0 };
         let elements = &self.wet.elements;
         ep.publish_topology(header, elements.len(), |out| out.copy_from_slice(elements))?;
-        self.publish_current(ep, 0, 0.0, 0.0)?;
+        self.dynamics.displacement(&mut self.current);
+        self.publish(ep, (0, 0.0, 0.0), &self.current, self.dynamics.velocity())?;
         self.write_probes()?;
+        let d = &self.dynamics;
         if let Some(f) = self.fields.as_mut() {
-            f.gather(0.0, &self.model, Some(&self.model), &self.v0)
+            f.gather(0.0, &d.model, Some(&d.model), d.velocity())
                 .map_err(|e| Failure::new(failure_code::SOLVER, format!("initial state: {e}")))?;
         }
         self.write_fields()?;
