@@ -43,7 +43,7 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
         let Coupled { structure, wet, dt_stable, .. } = prepare_coupled(case)?;
         let scheme = case.coupling.scheme;
         let dt = case.coupling.dt.min(case.coupling.t_end);
-        if let Some(message) = unstable_coupling(dt, dt_stable, scheme) {
+        if let Some(message) = unstable_coupling(dt, dt_stable, scheme, s.substeps) {
             return Err(case.field_error("coupling.dt", message).into());
         }
         writeln!(w, "  mesh       {}", mesh_summary(&structure.mesh))?;

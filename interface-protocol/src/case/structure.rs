@@ -160,6 +160,10 @@ pub struct StructureSection {
     /// Fraction of the critical step; default 0.8.
     #[serde(default)]
     pub safety: Option<f64>,
+    /// Coupled, central differences: substeps per coupling step (default: the least that keeps
+    /// each within the stable step, recomputed every coupling step).
+    #[serde(default)]
+    pub substeps: Option<u32>,
     /// End time of a run alone (static: the final load factor, default 1).
     #[serde(default)]
     pub t_end: Option<f64>,

@@ -115,7 +115,7 @@ impl RigidSolver {
         with_load: bool,
     ) -> Result<f64, Failure> {
         let load = with_load.then_some(self.load.as_slice());
-        self.scheme.predict(&mut self.state, dt, load);
+        let Ok(()) = self.scheme.predict(&mut self.state, dt, load);
         let target = self.scheme.predicted_time(t_from, dt);
         let p = &mut self.scheme;
         self.body.impose(target, &mut p.up, &mut p.vp, None);
@@ -415,8 +415,8 @@ mod coupled_tests {
     //! sequence, an analytic piston face answers in a fluid thread, and the piston's motion is
     //! compared with the closed form of m u'' + ρ0 c0 A u' + k u = -A p0.
     use super::*;
-    use interface_protocol::case::Scheme;
     use interface_protocol::case::Case;
+    use interface_protocol::case::Scheme;
     use interface_protocol::endpoint::{ControlPort, FluidEndpoint, LauncherLink, Timeouts};
     use interface_protocol::handshake::HelloInfo;
     use interface_protocol::messages::{command_kind, reply_kind, Reply, Role};

@@ -55,6 +55,8 @@ pub struct Participant {
     t_end: f64,
     dt_stable: f64,
     stable_rule: Option<StableStep>,
+    /// `structure.substeps` (None: as many as the stable step needs).
+    substeps: Option<u32>,
     t: f64,
     /// Coupling steps completed.
     steps: u64,
@@ -133,12 +135,23 @@ pub fn prepare_coupled(case: &Case) -> anyhow::Result<Coupled> {
     Ok(Coupled { structure, wet, dt_stable, stable_rule })
 }
 
-/// The refusal of a first coupling step `dt` above the stable step of the scheme's central
-/// differences.
-pub fn unstable_coupling(dt: f64, dt_stable: f64, scheme: Scheme) -> Option<String> {
-    (dt > dt_stable).then(|| {
+/// The refusal of a coupling step `dt` whose substeps exceed the stable step of the scheme's
+/// central differences: only with a fixed `structure.substeps` (by default the structure takes
+/// as many as the stable step needs).
+pub fn unstable_coupling(
+    dt: f64,
+    dt_stable: f64,
+    scheme: Scheme,
+    substeps: Option<u32>,
+) -> Option<String> {
+    let m = substeps?.max(1);
+    let h = dt / f64::from(m);
+    (scheme != Scheme::A6 && h > dt_stable).then(|| {
+        let each = if m > 1 { format!(" in {m} substeps of {h:.3e}") } else { String::new() };
         format!(
-            "coupling.dt = {dt:.3e} exceeds the stable step {dt_stable:.3e} of the {scheme:?} scheme's central differences"
+            "coupling.dt = {dt:.3e}{each} exceeds the stable step {dt_stable:.3e} of the \
+             {scheme:?} scheme's central differences (structure.substeps = {m}; leave it out to \
+             subcycle as the stable step needs)"
         )
     })
 }
@@ -162,7 +175,8 @@ impl Participant {
             fields_t: f64::NAN,
             bar: Some(Bar::new(case.coupling.t_end, quiet)),
             dynamics: FeDynamics::new(model, scheme, v0),
-            scheme: Staggered::new(scheme, n),
+            scheme: Staggered::new(scheme, n).with_substeps(s.substeps),
+            substeps: s.substeps,
             wet,
             x0: mesh.nodes.clone(),
             node_ids: (0..mesh.nodes.len()).map(|i| mesh.node_id(i)).collect(),
@@ -288,7 +302,9 @@ impl Participant {
         } else {
             None
         };
-        self.scheme.predict(&mut self.dynamics, dt, load);
+        self.scheme
+            .predict(&mut self.dynamics, dt, load)
+            .map_err(|e| Failure::new(failure_code::SOLVER, format!("PREDICT of step {n}: {e}")))?;
         self.publish_prediction(ep, (n, self.scheme.predicted_time(t_from, dt), dt))
     }
 
@@ -313,6 +329,7 @@ impl Participant {
         self.check_state(n, t_to, dt)?;
         if let Some(rule) = self.stable_rule {
             self.dt_stable = rule.at(&self.dynamics.model);
+            self.scheme.set_stable_step(self.dt_stable);
         }
         self.t = t_to;
         self.steps = n + 1;
@@ -343,9 +360,9 @@ impl Participant {
         let Some(state) = d.state() else { return Ok(()) };
         let (v, a, f_int) = (&state.v, &state.a, d.internal_force());
         let ids = &self.node_ids;
-        let scheme = self.scheme.scheme;
+        let (scheme, substeps) = (self.scheme.scheme, self.substeps);
         check_state(&d.model, &mut self.disp, (v, a, f_int), &|i| ids[i]).map_err(|e| {
-            let note = match unstable_coupling(dt, self.dt_stable, scheme) {
+            let note = match unstable_coupling(dt, self.dt_stable, scheme, substeps) {
                 Some(m) => format!(" ({m})"),
                 None => String::new(),
             };
@@ -410,10 +427,11 @@ impl Participant {
 
 impl Handler<StructureEndpoint> for Participant {
     fn init(&mut self, ep: &mut StructureEndpoint) -> Result<f64, Failure> {
-        if let Some(message) = unstable_coupling(self.first_dt, self.dt_stable, self.scheme.scheme)
-        {
+        let (dt, stable) = (self.first_dt, self.dt_stable);
+        if let Some(message) = unstable_coupling(dt, stable, self.scheme.scheme, self.substeps) {
             return Err(Failure::new(failure_code::SOLVER, message));
         }
+        self.scheme.set_stable_step(stable);
         let header = StepHeader { step: 0, time: 0.0, dt: 0.0, topology_version: 1, count: 0 };
         let elements = &self.wet.elements;
         ep.publish_topology(header, elements.len(), |out| out.copy_from_slice(elements))?;
