@@ -6,6 +6,18 @@
 //! `R^φ_i = Σ_j U_ij (φ*_ij - φ_i)`,  `U_ij = ½ (u_i + u_j)·ν_ij`,
 //! `φ*_ij = φ_ij` (MUSCL from `i`) if `U_ij >= 0`, else `φ_ji` (MUSCL from `j`).
 //!
+//! At an edge whose ends hold different fluids the velocity is that of the interface itself:
+//! `U_ij = u* |ν_ij|`, the contact velocity of the exact two-phase Riemann problem along `ν_ij`
+//! between the nodal states, the problem whose star states give the ghost-fluid fluxes there
+//! ([`crate::two_phase`], thesis Eq. 3.9). Those fluxes move each fluid's mass across the facet at
+//! `u*` (the gas side loses `ρ*_g u* |ν|`), and the nodes the interface passes are handed to the
+//! other fluid only when `φ` changes sign there, so the level set has to move at the same `u*`:
+//! with the mean nodal velocity instead it lags wherever that mean differs from `u*`, at a
+//! pressure jump at rest (where both nodal velocities start at zero and `u*` does not) and at a
+//! curved interface in a strained flow (a growing bubble, whose gas velocity grows and whose
+//! liquid velocity falls away from the interface), and the gas then loses mass it never gets back
+//! (test `level_set_contact`).
+//!
 //! An edge adds `U (φ* - φ_i)` to `R_i` and `-U (φ* - φ_j)` to `R_j`. With first-order states the
 //! scheme is the upwind scheme `dφ_j/dt = -Σ_{upwind i} |U_ij| (φ_j - φ_i)/|C_j|`: a convex
 //! combination of neighbours for a step within the flow's CFL limit (the flow's time step already
@@ -30,12 +42,42 @@ use crate::mesh::Mesh;
 use crate::reconstruct::gradient::LsqGradient;
 use crate::reconstruct::limiter::Limiter;
 use crate::reconstruct::muscl::extrapolate;
+use crate::riemann::{self, State1d};
+use crate::semidiscretization::Semidiscretization;
+
+/// `u*|ν|` of the exact two-phase Riemann problem along `ν` between the nodal states of an edge
+/// whose ends hold different fluids (the contact velocity the ghost-fluid fluxes move the
+/// interface with, [`crate::two_phase`]); `None` if the problem has no solution.
+fn contact_velocity(
+    semi: &Semidiscretization,
+    i: usize,
+    j: usize,
+    wi: &[f64; 5],
+    wj: &[f64; 5],
+    n: [f64; 3],
+) -> Option<f64> {
+    let (eos_i, eos_j) = (semi.eos_at(i), semi.eos_at(j));
+    let area = dot(n, n).sqrt();
+    let nh = [n[0] / area, n[1] / area, n[2] / area];
+    let star = riemann::solve_with_cutoff(
+        eos_i,
+        State1d { rho: wi[0], u: dot([wi[1], wi[2], wi[3]], nh), p: wi[4] },
+        eos_j,
+        State1d { rho: wj[0], u: dot([wj[1], wj[2], wj[3]], nh), p: wj[4] },
+        crate::two_phase::cutoff(eos_i, eos_j),
+    )
+    .ok()?;
+    Some(star.state.u * area)
+}
 
 /// `R^φ` of `lws.phi` with the velocities of `prim` into `lws.residual` (module docs), calling
 /// `update(i, R^φ_i, &mut out[i])` for every node as soon as its residual is complete (within the
 /// same deterministic pass over the edge blocks, bitwise independent of the thread count). Nodes
 /// with `open[i]` (on far-field, inflow or outflow boundaries) extrapolate first order; only the
-/// edges `e` with `through[e]` carry a flux (`None`: every edge).
+/// edges `e` with `through[e]` carry a flux (`None`: every edge). With `contact` (the flow's
+/// operator, holding the materials and EOS of the nodes `prim` belongs to) the edges between two
+/// fluids take the contact velocity of their two-phase Riemann problem (module docs); without it
+/// (a single fluid, or a velocity field given alone) every edge takes the mean nodal velocity.
 #[allow(clippy::too_many_arguments)]
 pub fn residual_and_update(
     mesh: &Mesh,
@@ -43,6 +85,7 @@ pub fn residual_and_update(
     limiter: Limiter,
     open: &[bool],
     through: Option<&[bool]>,
+    contact: Option<&Semidiscretization>,
     prim: &[[f64; 5]],
     lws: &mut LevelSetWorkspace,
     out: &mut [f64],
@@ -68,7 +111,12 @@ pub fn residual_and_update(
             let n = mesh.edge_normals[e];
             let (wi, wj) = (&prim[i], &prim[j]);
             let u = [0.5 * (wi[1] + wj[1]), 0.5 * (wi[2] + wj[2]), 0.5 * (wi[3] + wj[3])];
-            let un = dot(u, n);
+            let un = match contact {
+                Some(semi) if semi.material()[i] != semi.material()[j] => {
+                    contact_velocity(semi, i, j, wi, wj, n).unwrap_or(dot(u, n))
+                }
+                _ => dot(u, n),
+            };
             let (pi, pj) = (phi[i][0], phi[j][0]);
             let (mut pij, mut pji) = (pi, pj);
             if second_order {
@@ -149,6 +197,7 @@ mod tests {
                 limiter,
                 &open,
                 None,
+                None,
                 &prim,
                 &mut lws,
                 &mut stage,
@@ -163,6 +212,7 @@ mod tests {
                 &gradient,
                 limiter,
                 &open,
+                None,
                 None,
                 &prim,
                 &mut lws,

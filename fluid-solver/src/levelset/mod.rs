@@ -35,6 +35,8 @@ pub mod ghost;
 pub mod gradient;
 pub mod init;
 pub mod reinit;
+#[cfg(test)]
+mod strain_tests;
 
 use crate::bc::BoundaryCondition;
 use crate::embedded::adjacency::NodeEdges;

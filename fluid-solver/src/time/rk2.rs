@@ -187,6 +187,7 @@ fn stages_with_phi(
             limiter,
             advection.open,
             advection.through,
+            Some(semi),
             &ws.prim,
             lws,
             &mut phi_stage,
