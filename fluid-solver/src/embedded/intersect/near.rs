@@ -9,6 +9,13 @@
 //! edge none of whose ends is such a node crosses no triangle: each pass over [`Near`] gives
 //! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
 //! ([`NodeBoxes`], built once with the mesh) is queried with the leaves of the surface's tree.
+//!
+//! That traversal meets every pair of a node and a triangle whose boxes overlap, and [`Near`]
+//! keeps them, grouped by node: each box a pass searches around node `i` (an edge of `i`, its
+//! occlusion ball, its projection box, the node itself) lies in the reach box of `i`, so the
+//! triangles recorded for `i` hold every triangle whose box meets it, and the pass tests those
+//! instead of querying the tree from its root. An edge takes the triangles of its end with fewer
+//! (none when one end is not near: its reach box, which holds the edge, meets no triangle box).
 
 use super::OCCLUSION;
 use crate::embedded::adjacency::NodeEdges;
@@ -167,6 +174,7 @@ mod tests {
     use super::*;
     use crate::embedded::intersect::{collision, collision_near, projection, projection_near};
     use crate::embedded::intersect::{Intersections, SurfaceAt};
+    use crate::embedded::status::swept_nodes_near;
     use crate::embedded::status::NodeStatus;
     use crate::embedded::status::{flood_fill, swept_nodes, swept_nodes_among, update_sides};
     use crate::embedded::tests::{box_surface, cube_mesh, plane, sphere};
@@ -187,6 +195,7 @@ mod tests {
         assert_eq!(projection_near(mesh, &adj, at, &near), projection(mesh, &adj, at), "{label}");
         let swept = swept_nodes(mesh, s, &bvh);
         assert_eq!(swept_nodes_among(mesh, s, &bvh, &near.nodes), swept, "{label}: swept");
+        assert_eq!(swept_nodes_near(mesh, s, &bvh, &near), swept, "{label}: swept, recorded");
         assert!(!c42.cuts.is_empty(), "{label}: nothing cut");
         assert!(near.edges.len() < mesh.n_edges(), "{label}: every edge is near");
         boxes.tree.validate().unwrap();

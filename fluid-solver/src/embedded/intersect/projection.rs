@@ -254,7 +254,8 @@ fn decide(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>, near: &Near) ->
             // inside b_i, look for it beyond b_i.
             let r = cp.dist2.sqrt();
             if (0..3).any(|d| p[d] - r < lo[d] || p[d] + r > hi[d]) {
-                (t, cp) = at.nearest_point(p, r * (1.0 + 1e-12) + f64::MIN_POSITIVE, false, None)?;
+                (t, cp) =
+                    at.nearest_point(p, r * (1.0 + 1e-12) + f64::MIN_POSITIVE, false, None)?;
             }
             let [a, b, c] = at.corners(t);
             let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
