@@ -22,6 +22,9 @@ use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
 
+/// Longest recorded triangle list searched as a list (a longer one is searched by the tree).
+pub const LIST_MAX: usize = 24;
+
 /// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeBoxes {
@@ -133,7 +136,8 @@ impl Near {
 
     /// Calls `visit` with every triangle of `bvh` whose box overlaps `[lo, hi]`, a box inside the
     /// reach box of node `i` (the node's edges, its occlusion ball, its projection box): from the
-    /// triangles recorded for `i` when there are, else by a query from the root. The same
+    /// triangles recorded for `i` when there are at most [`LIST_MAX`], else by a query from the
+    /// root (which prunes a long list faster). The same
     /// triangles either way (a triangle box meeting `[lo, hi]` meets the reach box), in another
     /// order. `bvh` must be the hierarchy `find` was given, unchanged since.
     #[inline]
@@ -146,7 +150,7 @@ impl Near {
         mut visit: impl FnMut(u32),
     ) {
         match self.triangles_of(i) {
-            Some(tris) => {
+            Some(tris) if tris.len() <= LIST_MAX => {
                 for &t in tris {
                     let (a, b) = bvh.triangle_box(t as usize);
                     if overlaps(&a, &b, lo, hi) {
@@ -154,7 +158,7 @@ impl Near {
                     }
                 }
             }
-            None => bvh.for_each_overlap(lo, hi, visit),
+            _ => bvh.for_each_overlap(lo, hi, visit),
         }
     }
 
