@@ -27,7 +27,7 @@ use crate::embedded::generate::{cylinder, plate};
 use crate::embedded::intersect::{collision, projection, Near, SurfaceAt};
 use crate::embedded::motion::RigidMotion;
 use crate::embedded::riemann_fs::{add_wall_fluxes, WallFluxView, WallMaterial};
-use crate::embedded::status::swept_nodes_among;
+use crate::embedded::status::swept_nodes_near;
 use crate::embedded::step::EmbeddedStep;
 use crate::embedded::swept::Swept;
 use crate::embedded::tracker::{Seed, Tracker};
@@ -312,7 +312,7 @@ fn track(
         stamp("near", &mut lap);
         let cuts = parts.cuts_near(mesh, &near)?;
         stamp("intersect", &mut lap);
-        let swept = swept_nodes_among(mesh, &parts.surface, &parts.bvh, &near.nodes);
+        let swept = swept_nodes_near(mesh, &parts.surface, &parts.bvh, &near);
         stamp("swept_nodes", &mut lap);
         let changes = parts.move_sides(mesh, cuts, &swept, &near);
         stamp("update_sides", &mut lap);

@@ -243,11 +243,11 @@ impl Bvh {
         }
     }
 
-    /// The items of this tree whose boxes overlap an item box of `queries`, ascending, by a
-    /// traversal of both trees at once (pairs of nodes whose boxes overlap, down to pairs of
-    /// leaves, whose items are tested box against box), in parallel over the subtrees of
-    /// `queries` below its first levels.
-    pub fn overlapping(&self, queries: &Bvh) -> Vec<u32> {
+    /// Every pair `[k, t]` of an item `k` of this tree and an item `t` of `queries` whose boxes
+    /// overlap, each pair once, by a traversal of both trees at once (pairs of nodes whose boxes
+    /// overlap, down to pairs of leaves, whose items are tested box against box), in parallel
+    /// over the subtrees of `queries` below its first levels. The order is fixed by the trees.
+    pub fn overlapping_pairs(&self, queries: &Bvh) -> Vec<[u32; 2]> {
         use rayon::prelude::*;
         if self.is_empty() || queries.is_empty() {
             return Vec::new();
@@ -268,7 +268,8 @@ impl Bvh {
             }
             roots = next;
         }
-        let mut hits: Vec<u32> = roots
+        let extent = |n: &Node| (0..3).map(|d| n.hi[d] - n.lo[d]).sum::<f64>();
+        roots
             .par_iter()
             .flat_map_iter(|&q| {
                 let mut found = Vec::new();
@@ -278,17 +279,16 @@ impl Bvh {
                     if !overlaps(&na.lo, &na.hi, &nb.lo, &nb.hi) {
                         continue;
                     }
-                    let extent = |n: &Node| (0..3).map(|d| n.hi[d] - n.lo[d]).sum::<f64>();
                     match (na.count > 0, nb.count > 0) {
                         (true, true) => {
                             let items = &queries.order[na.first as usize..][..na.count as usize];
                             for &k in &self.order[nb.first as usize..][..nb.count as usize] {
                                 let (lo, hi) = (&self.tri_lo[k as usize], &self.tri_hi[k as usize]);
-                                if items.iter().any(|&t| {
-                                    let t = t as usize;
-                                    overlaps(lo, hi, &queries.tri_lo[t], &queries.tri_hi[t])
-                                }) {
-                                    found.push(k);
+                                for &t in items {
+                                    let t_ = t as usize;
+                                    if overlaps(lo, hi, &queries.tri_lo[t_], &queries.tri_hi[t_]) {
+                                        found.push([k, t]);
+                                    }
                                 }
                             }
                         }
@@ -302,10 +302,7 @@ impl Bvh {
                 }
                 found
             })
-            .collect();
-        hits.par_sort_unstable();
-        hits.dedup();
-        hits
+            .collect()
     }
 
     /// Checks the invariants: every parent box contains its children, every leaf box contains its

@@ -11,7 +11,7 @@
 
 use super::adjacency::NodeEdges;
 use super::bvh::Bvh;
-use super::intersect::Intersections;
+use super::intersect::{Intersections, Near};
 use super::predicates::sweep_over_point;
 use super::Surface;
 use crate::mesh::geometry::{norm, sub};
@@ -155,21 +155,37 @@ pub fn swept_nodes(mesh: &Mesh, surface: &Surface, bvh: &Bvh) -> Vec<u32> {
 
 /// [`swept_nodes`] among `candidates` (ascending; for example [`Near::nodes`], which holds every
 /// node inside a triangle box).
-///
-/// [`Near::nodes`]: super::intersect::Near
 pub fn swept_nodes_among(
     mesh: &Mesh,
     surface: &Surface,
     bvh: &Bvh,
     candidates: &[u32],
 ) -> Vec<u32> {
+    swept_in(mesh, surface, bvh, candidates, |p, _, visit| bvh.for_each_overlap(p, p, visit))
+}
+
+/// [`swept_nodes`] among the nodes of `near` ([`Near::find`] over `bvh`), each tested against
+/// the triangles recorded for it (a node is inside its reach box).
+pub fn swept_nodes_near(mesh: &Mesh, surface: &Surface, bvh: &Bvh, near: &Near) -> Vec<u32> {
+    swept_in(mesh, surface, bvh, &near.nodes, |p, i, visit| {
+        near.for_each_overlap(bvh, i, p, p, visit)
+    })
+}
+
+/// The nodes of `candidates` a triangle passed over, the triangles whose box holds node `i` at
+/// `p` given by `query(p, i, visit)`.
+fn swept_in<Q>(mesh: &Mesh, surface: &Surface, bvh: &Bvh, candidates: &[u32], query: Q) -> Vec<u32>
+where
+    Q: Fn(&[f64; 3], usize, &mut dyn FnMut(u32)) + Sync,
+{
+    debug_assert_eq!(bvh.len(), surface.triangles.len(), "hierarchy of another surface");
     candidates
         .par_iter()
         .copied()
         .filter(|&i| {
             let p = mesh.coords[i as usize];
             let mut swept = false;
-            bvh.for_each_overlap(&p, &p, |t| {
+            query(&p, i as usize, &mut |t| {
                 if !swept {
                     let tri = surface.triangles[t as usize];
                     let from = tri.map(|n| surface.x_a[n as usize]);

@@ -14,7 +14,7 @@ use super::intersect::{
 };
 use super::intersect::{SurfaceAt, SurfaceAtError};
 use super::riemann_fs::WallPressures;
-use super::status::{flood_fill, redecided, step_ratio, swept_nodes_among, update_sides_among};
+use super::status::{flood_fill, redecided, step_ratio, swept_nodes_near, update_sides_among};
 use super::status::{NodeSides, NodeStatus};
 use super::status::{SideChange, StatusError};
 use super::Surface;
@@ -116,7 +116,7 @@ impl Tracker {
         self.bvh.update(&self.surface);
         let near = Near::find(mesh, &self.adjacency, &self.node_boxes, &self.bvh);
         let cuts = self.cuts_near(mesh, &near)?;
-        let swept = swept_nodes_among(mesh, &self.surface, &self.bvh, &near.nodes);
+        let swept = swept_nodes_near(mesh, &self.surface, &self.bvh, &near);
         Ok(self.move_sides(mesh, cuts, &swept, &near))
     }
 

@@ -36,12 +36,12 @@ pub fn collision_near(
     near: &Near,
 ) -> Intersections {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
-    let occluded = at.occluded(mesh, &adjacency.h_min, true, &near.nodes);
+    let occluded = at.occluded(mesh, &adjacency.h_min, true, near);
     let cuts: Vec<CutEdge> = near
         .edges
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
-            chunk.iter().filter_map(|&e| edge_cut(mesh, adjacency, at, &occluded, e as usize))
+            chunk.iter().filter_map(|&e| edge_cut(mesh, adjacency, at, near, &occluded, e as usize))
         })
         .collect();
     Intersections::from_sorted(mesh, cuts, occluded)
@@ -53,10 +53,11 @@ fn edge_cut(
     mesh: &Mesh,
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
+    near: &Near,
     occluded: &[bool],
     e: usize,
 ) -> Option<CutEdge> {
-    if let Some(c) = at.nearest_crossing(mesh, e, true) {
+    if let Some(c) = at.nearest_crossing(mesh, near, e, true) {
         return Some(c);
     }
     let [i, j] = mesh.edges[e].map(|v| v as usize);
@@ -64,7 +65,7 @@ fn edge_cut(
     for (end, alpha) in [(i, 0.0), (j, 1.0)] {
         if occluded[end] {
             let r = super::OCCLUSION * adjacency.h_min[end];
-            if let Some((t, cp)) = at.nearest_point(mesh.coords[end], r, true) {
+            if let Some((t, cp)) = at.nearest_point(mesh.coords[end], r, true, Some((near, end))) {
                 return Some(at.cut(e, t, alpha, cp.bary));
             }
         }

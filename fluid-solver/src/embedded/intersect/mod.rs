@@ -143,15 +143,21 @@ impl SurfaceAt<'_> {
     }
 
     /// The crossing of edge `e` nearest to its node `i` (smallest α, then lowest triangle), among
-    /// the triangles whose box meets the edge's box, counting only hits where phi `>= 0` when
-    /// `crack_aware`.
-    fn nearest_crossing(&self, mesh: &Mesh, e: usize, crack_aware: bool) -> Option<CutEdge> {
-        let [i, j] = mesh.edges[e];
-        let (p, q) = (mesh.coords[i as usize], mesh.coords[j as usize]);
+    /// the triangles whose box meets the edge's box (those recorded in `near` for an end of the
+    /// edge), counting only hits where phi `>= 0` when `crack_aware`.
+    fn nearest_crossing(
+        &self,
+        mesh: &Mesh,
+        near: &Near,
+        e: usize,
+        crack_aware: bool,
+    ) -> Option<CutEdge> {
+        let [i, j] = mesh.edges[e].map(|v| v as usize);
+        let (p, q) = (mesh.coords[i], mesh.coords[j]);
         let lo = [0, 1, 2].map(|d| p[d].min(q[d]));
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
         let mut best: Option<(f64, u32, [f64; 3])> = None;
-        self.bvh.for_each_overlap(&lo, &hi, |t| {
+        near.for_each_overlap(self.bvh, near.end_with_fewer(i, j), &lo, &hi, |t| {
             let [a, b, c] = self.corners(t);
             if let Some(h) = segment_triangle(p, q, a, b, c) {
                 if crack_aware && below_zero_or_nan(self.phi(t, h.bary)) {
@@ -167,12 +173,19 @@ impl SurfaceAt<'_> {
 
     /// The closest point of the surface to `p` among the triangles whose box meets the box of
     /// half-width `radius` around it (lowest triangle on ties), with phi `>= 0` there when
-    /// `crack_aware`.
-    fn nearest_point(&self, p: [f64; 3], radius: f64, crack_aware: bool) -> Option<(u32, Closest)> {
+    /// `crack_aware`. With `within = Some((near, i))` that box lies inside the reach box of node
+    /// `i` and the triangles recorded for `i` are searched ([`Near::for_each_overlap`]).
+    fn nearest_point(
+        &self,
+        p: [f64; 3],
+        radius: f64,
+        crack_aware: bool,
+        within: Option<(&Near, usize)>,
+    ) -> Option<(u32, Closest)> {
         let lo = p.map(|v| v - radius);
         let hi = p.map(|v| v + radius);
         let mut best: Option<(u32, Closest)> = None;
-        self.bvh.for_each_overlap(&lo, &hi, |t| {
+        let visit = |t| {
             let [a, b, c] = self.corners(t);
             let cp = closest_point(p, a, b, c);
             if crack_aware && below_zero_or_nan(self.phi(t, cp.bary)) {
@@ -181,14 +194,19 @@ impl SurfaceAt<'_> {
             if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
                 best = Some((t, cp));
             }
-        });
+        };
+        match within {
+            Some((near, i)) => near.for_each_overlap(self.bvh, i, &lo, &hi, visit),
+            None => self.bvh.for_each_overlap(&lo, &hi, visit),
+        }
         best
     }
 
     /// Occluded nodes (Alg. 4.2 step 3.1): within `OCCLUSION * h_min(i)` of the surface, among
-    /// `nodes` (ascending; the others are not).
-    fn occluded(&self, mesh: &Mesh, h_min: &[f64], crack_aware: bool, nodes: &[u32]) -> Vec<bool> {
+    /// the nodes of `near` (the others are not).
+    fn occluded(&self, mesh: &Mesh, h_min: &[f64], crack_aware: bool, near: &Near) -> Vec<bool> {
         use rayon::prelude::*;
+        let nodes = &near.nodes;
         let hit: Vec<bool> = nodes
             .par_iter()
             .map(|&i| {
@@ -196,7 +214,7 @@ impl SurfaceAt<'_> {
                 let r = OCCLUSION * h_min[i];
                 r.is_finite()
                     && self
-                        .nearest_point(mesh.coords[i], r, crack_aware)
+                        .nearest_point(mesh.coords[i], r, crack_aware, Some((near, i)))
                         .is_some_and(|(_, c)| c.dist2 <= r * r)
             })
             .collect();

@@ -9,11 +9,21 @@
 //! edge none of whose ends is such a node crosses no triangle: each pass over [`Near`] gives
 //! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
 //! ([`NodeBoxes`], built once with the mesh) is queried with the leaves of the surface's tree.
+//!
+//! That traversal meets every pair of a node and a triangle whose boxes overlap, and [`Near`]
+//! keeps them, grouped by node: each box a pass searches around node `i` (an edge of `i`, its
+//! occlusion ball, its projection box, the node itself) lies in the reach box of `i`, so the
+//! triangles recorded for `i` hold every triangle whose box meets it, and the pass tests those
+//! instead of querying the tree from its root. An edge takes the triangles of its end with fewer
+//! (none when one end is not near: its reach box, which holds the edge, meets no triangle box).
 
 use super::OCCLUSION;
 use crate::embedded::adjacency::NodeEdges;
-use crate::embedded::bvh::Bvh;
+use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
+
+/// Longest recorded triangle list searched as a list (a longer one is searched by the tree).
+pub const LIST_MAX: usize = 24;
 
 /// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
 #[derive(Debug, Clone, PartialEq)]
@@ -51,26 +61,54 @@ impl NodeBoxes {
 }
 
 /// Mesh nodes and edges, each list ascending: the nodes whose reach box meets a triangle box and
-/// every edge touching one of them.
+/// every edge touching one of them; with, from [`Near::find`], the triangles whose box meets each
+/// node's reach box.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Near {
     pub nodes: Vec<u32>,
     pub edges: Vec<u32>,
+    /// The triangles of node `i` are `triangles[offsets[i]..offsets[i + 1]]` (`offsets` has one
+    /// entry per mesh node and one more); empty for the full passes of [`Near::all`].
+    offsets: Vec<u32>,
+    triangles: Vec<u32>,
 }
 
 impl Near {
-    /// Every node and edge (the full passes).
+    /// Every node and edge (the full passes), queried from the root of the hierarchy.
     pub fn all(mesh: &Mesh) -> Near {
         Near {
             nodes: (0..mesh.n_nodes() as u32).collect(),
             edges: (0..mesh.n_edges() as u32).collect(),
+            offsets: Vec::new(),
+            triangles: Vec::new(),
         }
     }
 
-    /// The nodes of `boxes` whose reach boxes meet a triangle box of `bvh`, with their edges.
+    /// The nodes of `boxes` whose reach boxes meet a triangle box of `bvh`, with their edges and
+    /// the triangles each reach box meets.
     pub fn find(mesh: &Mesh, adjacency: &NodeEdges, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
-        let nodes = boxes.tree.overlapping(bvh);
+        let pairs = boxes.tree.overlapping_pairs(bvh);
+        // The pairs sorted by node, by counting (each pair comes once).
+        let n = mesh.n_nodes();
+        let mut offsets = vec![0u32; n + 1];
+        for &[k, _] in &pairs {
+            offsets[k as usize + 1] += 1;
+        }
+        let mut nodes = Vec::new();
+        for i in 0..n {
+            if offsets[i + 1] > 0 {
+                nodes.push(i as u32);
+            }
+            offsets[i + 1] += offsets[i];
+        }
+        let mut next = offsets.clone();
+        let mut triangles = vec![0u32; pairs.len()];
+        for &[k, t] in &pairs {
+            let slot = &mut next[k as usize];
+            triangles[*slot as usize] = t;
+            *slot += 1;
+        }
         // The edges of those nodes, ascending, through a bit set over the edges.
         let mut bits = vec![0u64; mesh.n_edges().div_ceil(64)];
         for &i in &nodes {
@@ -86,7 +124,52 @@ impl Near {
                 word &= word - 1;
             }
         }
-        Near { nodes, edges }
+        Near { nodes, edges, offsets, triangles }
+    }
+
+    /// The triangles whose box meets the reach box of node `i`, if recorded ([`Near::find`]).
+    #[inline]
+    pub fn triangles_of(&self, i: usize) -> Option<&[u32]> {
+        let (a, b) = (*self.offsets.get(i)?, *self.offsets.get(i + 1)?);
+        Some(&self.triangles[a as usize..b as usize])
+    }
+
+    /// Calls `visit` with every triangle of `bvh` whose box overlaps `[lo, hi]`, a box inside the
+    /// reach box of node `i` (the node's edges, its occlusion ball, its projection box): from the
+    /// triangles recorded for `i` when there are at most [`LIST_MAX`], else by a query from the
+    /// root (which prunes a long list faster). The same
+    /// triangles either way (a triangle box meeting `[lo, hi]` meets the reach box), in another
+    /// order. `bvh` must be the hierarchy `find` was given, unchanged since.
+    #[inline]
+    pub fn for_each_overlap(
+        &self,
+        bvh: &Bvh,
+        i: usize,
+        lo: &[f64; 3],
+        hi: &[f64; 3],
+        mut visit: impl FnMut(u32),
+    ) {
+        match self.triangles_of(i) {
+            Some(tris) if tris.len() <= LIST_MAX => {
+                for &t in tris {
+                    let (a, b) = bvh.triangle_box(t as usize);
+                    if overlaps(&a, &b, lo, hi) {
+                        visit(t);
+                    }
+                }
+            }
+            _ => bvh.for_each_overlap(lo, hi, visit),
+        }
+    }
+
+    /// Of the two ends of edge `[i, j]`, the one with fewer recorded triangles (`i` when none
+    /// are recorded): both reach boxes hold the edge.
+    #[inline]
+    pub fn end_with_fewer(&self, i: usize, j: usize) -> usize {
+        match (self.triangles_of(i), self.triangles_of(j)) {
+            (Some(a), Some(b)) if b.len() < a.len() => j,
+            _ => i,
+        }
     }
 }
 
@@ -95,6 +178,7 @@ mod tests {
     use super::*;
     use crate::embedded::intersect::{collision, collision_near, projection, projection_near};
     use crate::embedded::intersect::{Intersections, SurfaceAt};
+    use crate::embedded::status::swept_nodes_near;
     use crate::embedded::status::NodeStatus;
     use crate::embedded::status::{flood_fill, swept_nodes, swept_nodes_among, update_sides};
     use crate::embedded::tests::{box_surface, cube_mesh, plane, sphere};
@@ -115,6 +199,7 @@ mod tests {
         assert_eq!(projection_near(mesh, &adj, at, &near), projection(mesh, &adj, at), "{label}");
         let swept = swept_nodes(mesh, s, &bvh);
         assert_eq!(swept_nodes_among(mesh, s, &bvh, &near.nodes), swept, "{label}: swept");
+        assert_eq!(swept_nodes_near(mesh, s, &bvh, &near), swept, "{label}: swept, recorded");
         assert!(!c42.cuts.is_empty(), "{label}: nothing cut");
         assert!(near.edges.len() < mesh.n_edges(), "{label}: every edge is near");
         boxes.tree.validate().unwrap();

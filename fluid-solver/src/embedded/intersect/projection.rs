@@ -50,8 +50,8 @@ pub fn projection_near(
 
 /// Per node: inside the closed surface (Alg. 4.1 steps 1-4).
 pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Vec<bool> {
-    let all: Vec<u32> = (0..mesh.n_nodes() as u32).collect();
-    flood(mesh, adjacency, &all, decide(mesh, adjacency, at, &all))
+    let all = Near::all(mesh);
+    flood(mesh, adjacency, &all.nodes, decide(mesh, adjacency, at, &all))
 }
 
 /// Steps 1-4 over the whole mesh from the near nodes: the inside of every node, the edges whose
@@ -62,7 +62,7 @@ fn whole_mesh(
     at: SurfaceAt<'_>,
     near: &Near,
 ) -> (Vec<bool>, Vec<u32>, Intersections) {
-    let inside = flood(mesh, adjacency, &near.nodes, decide(mesh, adjacency, at, &near.nodes));
+    let inside = flood(mesh, adjacency, &near.nodes, decide(mesh, adjacency, at, near));
     let differ: Vec<u32> =
         (0..mesh.n_edges() as u32).filter(|&e| differs(mesh, &inside, e)).collect();
     let cuts = cut_edges(mesh, adjacency, at, near, &differ);
@@ -118,7 +118,7 @@ impl KeptInside {
         at: SurfaceAt<'_>,
         near: &Near,
     ) -> Intersections {
-        let decided = decide(mesh, adjacency, at, &near.nodes);
+        let decided = decide(mesh, adjacency, at, near);
         if !self.update_near(mesh, near, &decided) {
             self.full_fills += 1;
             self.inside = flood(mesh, adjacency, &near.nodes, decided);
@@ -205,17 +205,17 @@ fn cut_edges(
     near: &Near,
     differ: &[u32],
 ) -> Intersections {
-    let occluded = at.occluded(mesh, &adjacency.h_min, false, &near.nodes);
+    let occluded = at.occluded(mesh, &adjacency.h_min, false, near);
     let cuts: Vec<CutEdge> = differ
         .par_chunks(CHUNK)
-        .flat_map_iter(|chunk| chunk.iter().filter_map(|&e| edge_cut(mesh, at, e as usize)))
+        .flat_map_iter(|chunk| chunk.iter().filter_map(|&e| edge_cut(mesh, at, near, e as usize)))
         .collect();
     Intersections::from_sorted(mesh, cuts, occluded)
 }
 
 /// The cut of edge `e`, whose ends differ.
-fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, e: usize) -> Option<CutEdge> {
-    if let Some(c) = at.nearest_crossing(mesh, e, false) {
+fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, near: &Near, e: usize) -> Option<CutEdge> {
+    if let Some(c) = at.nearest_crossing(mesh, near, e, false) {
         return Some(c);
     }
     let [i, j] = mesh.edges[e].map(|v| v as usize);
@@ -223,31 +223,26 @@ fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, e: usize) -> Option<CutEdge> {
     let d = sub(q, p);
     let l2 = dot(d, d);
     let mid = add(p, scale(d, 0.5));
-    let (t, cp) = at.nearest_point(mid, l2.sqrt(), false)?;
+    let (t, cp) = at.nearest_point(mid, l2.sqrt(), false, None)?;
     let [a, b, c] = at.corners(t);
     let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
     let alpha = (dot(sub(x, p), d) / l2).clamp(0.0, 1.0);
     Some(at.cut(e, t, alpha, cp.bary))
 }
 
-/// Steps 1-3 at `candidates` (ascending): each near node decided by its closest point (`None`
-/// for a node whose box meets no triangle box: left to the flood fill).
-fn decide(
-    mesh: &Mesh,
-    adjacency: &NodeEdges,
-    at: SurfaceAt<'_>,
-    candidates: &[u32],
-) -> Vec<Option<bool>> {
+/// Steps 1-3 at the nodes of `near`: each near node decided by its closest point (`None` for a
+/// node whose box meets no triangle box: left to the flood fill).
+fn decide(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>, near: &Near) -> Vec<Option<bool>> {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     let normals = PseudoNormals::new(at);
-    candidates
+    near.nodes
         .par_iter()
         .map(|&i| {
             let i = i as usize;
             let p = mesh.coords[i];
             let (lo, hi) = adjacency.node_box(mesh, i);
             let mut best: Option<(u32, Closest)> = None;
-            at.bvh.for_each_overlap(&lo, &hi, |t| {
+            near.for_each_overlap(at.bvh, i, &lo, &hi, |t| {
                 let [a, b, c] = at.corners(t);
                 let cp = closest_point(p, a, b, c);
                 if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
@@ -259,7 +254,8 @@ fn decide(
             // inside b_i, look for it beyond b_i.
             let r = cp.dist2.sqrt();
             if (0..3).any(|d| p[d] - r < lo[d] || p[d] + r > hi[d]) {
-                (t, cp) = at.nearest_point(p, r * (1.0 + 1e-12) + f64::MIN_POSITIVE, false)?;
+                (t, cp) =
+                    at.nearest_point(p, r * (1.0 + 1e-12) + f64::MIN_POSITIVE, false, None)?;
             }
             let [a, b, c] = at.corners(t);
             let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
