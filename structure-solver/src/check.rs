@@ -8,6 +8,7 @@
 use std::fmt::Write;
 
 use interface_protocol::case::Case;
+use interface_protocol::coupling::Staggered;
 
 use crate::build::section;
 use crate::couple::{prepare_coupled, unstable_coupling, Coupled};
@@ -46,6 +47,9 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
         if let Some(message) = unstable_coupling(dt, dt_stable, scheme, s.substeps) {
             return Err(case.field_error("coupling.dt", message).into());
         }
+        let mut staggered = Staggered::new(scheme, 0).with_substeps(s.substeps);
+        staggered.set_stable_step(dt_stable);
+        let m = staggered.substeps(dt);
         writeln!(w, "  mesh       {}", mesh_summary(&structure.mesh))?;
         writeln!(
             w,
@@ -54,6 +58,11 @@ pub fn check(case: &Case) -> anyhow::Result<String> {
             wet.nodes.len(),
             wet.elements.len(),
             dt_stable
+        )?;
+        writeln!(
+            w,
+            "  substeps   {m} per coupling step of {dt:.3e} s ({})",
+            if s.substeps.is_some() { "structure.substeps" } else { "from the stable step" }
         )?;
         probe_nodes = s.probes.iter().map(|p| structure.mesh.nearest_node(p.point)).collect();
         structure.mesh

@@ -165,7 +165,19 @@ fn check_validates_alone_and_coupled_cases_without_writing() {
     let err = stderr(&o);
     assert!(!o.status.success());
     assert!(err.contains("field `structure.wet_set`") && err.contains("lid"), "{err}");
-    let o = check(&case("plate-piston"), &["--set", "coupling.dt=1e-3"]);
+    assert!(text.contains("substeps   1 per coupling step"), "{text}");
+    // a coupling step past the stable one is subcycled unless the substeps are fixed
+    let o = check(&case("plate-piston"), &["--set", "coupling.dt=1e-4"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        text.contains("substeps   13 per coupling step of 1.000e-4 s (from the stable step)"),
+        "{text}"
+    );
+    let o = check(
+        &case("plate-piston"),
+        &["--set", "coupling.dt=1e-4", "--set", "structure.substeps=1"],
+    );
     let err = stderr(&o);
     assert!(!o.status.success() && err.contains("exceeds the stable step"), "{err}");
 }
