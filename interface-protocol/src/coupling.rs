@@ -299,14 +299,37 @@ impl Staggered {
     }
 
     /// The scheme's history a checkpoint must keep, named: C0's `F^{n+1/2}` and `v^{n-1/2}`,
-    /// A6's `â^n`, the load sample before (CSS F^n, C0 F^{n-1/2}).
-    pub fn history(&self) -> [(&'static str, &[f64]); 4] {
+    /// A6's `â^n`, the load sample before (CSS F^n, C0 F^{n-1/2}) and the times `[t^n,
+    /// t_prev, t_half]` of the samples. [`Staggered::restore`] reads it back.
+    pub fn history(&self) -> [(&'static str, Vec<f64>); 5] {
         [
-            ("f_half", &self.f_half),
-            ("v_half_prev", &self.v_half_prev),
-            ("a_hat", &self.a_hat),
-            ("f_prev", &self.f_prev),
+            ("f_half", self.f_half.clone()),
+            ("v_half_prev", self.v_half_prev.clone()),
+            ("a_hat", self.a_hat.clone()),
+            ("f_prev", self.f_prev.clone()),
+            ("times", vec![self.t, self.t_prev, self.t_half]),
         ]
+    }
+
+    /// Restores the [`Staggered::history`] that `get` returns by name, after CORRECT of the
+    /// step the checkpoint closed: the sequence continues with PREDICT bitwise as if never
+    /// stopped. An error names the missing or mis-sized entry.
+    pub fn restore(&mut self, mut get: impl FnMut(&str) -> Option<Vec<f64>>) -> Result<(), String> {
+        let n = self.f_half.len();
+        let mut take = |name: &str, len: usize| match get(name) {
+            Some(v) if v.len() == len => Ok(v),
+            Some(v) => {
+                Err(format!("coupling history `{name}` holds {} values, expected {len}", v.len()))
+            }
+            None => Err(format!("coupling history `{name}` is missing")),
+        };
+        self.f_half = take("f_half", n)?;
+        self.v_half_prev = take("v_half_prev", n)?;
+        self.a_hat = take("a_hat", n)?;
+        self.f_prev = take("f_prev", n)?;
+        let times = take("times", 3)?;
+        (self.t, self.t_prev, self.t_half) = (times[0], times[1], times[2]);
+        Ok(())
     }
 
     /// START with the load F^0 (a^0 = M^{-1}(F^0 - f_int(u^0, v^0))). Returns whether `up`/`vp`
@@ -475,6 +498,18 @@ mod tests {
 
     /// [`run_to`] with `substeps` central-difference substeps per coupling step.
     fn run_sub(scheme: Scheme, dt: f64, t_end: f64, substeps: Option<u32>) -> f64 {
+        run_restarted(scheme, dt, t_end, substeps, None)
+    }
+
+    /// [`run_sub`], the scheme's state rebuilt from its history after CORRECT of step
+    /// `restart_after` as a restart does: a fresh `Staggered` restored, the dynamics copied.
+    fn run_restarted(
+        scheme: Scheme,
+        dt: f64,
+        t_end: f64,
+        substeps: Option<u32>,
+        restart_after: Option<usize>,
+    ) -> f64 {
         let n = (t_end / dt * (1.0 - 1e-12)).ceil() as usize;
         let params = Diagonal { m: vec![M], k: vec![K], c: vec![0.0] };
         let mut d = Oscillators::new(params, &[U0], &[0.0]);
@@ -491,8 +526,40 @@ mod tests {
             s.predict(&mut d, h, load.as_ref().map(std::slice::from_ref)).unwrap();
             let f = fluid(s.up[0], s.vp[0]);
             s.correct(&mut d, &[f], h).unwrap();
+            if restart_after == Some(step) {
+                let history = s.history();
+                let mut fresh = Staggered::new(scheme, 1).with_substeps(substeps);
+                fresh
+                    .restore(|name| {
+                        history.iter().find(|(k, _)| *k == name).map(|(_, v)| v.clone())
+                    })
+                    .unwrap();
+                s = fresh;
+                d = d.clone();
+            }
         }
         d.u[0]
+    }
+
+    /// A scheme restored from its history after any step continues bitwise (substeps included);
+    /// a missing or mis-sized entry is refused by name.
+    #[test]
+    fn a_restored_history_continues_bitwise() {
+        let (dt, t_end) = (T / 50.0, T + 0.37 * T / 50.0);
+        for scheme in [Scheme::C0, Scheme::Css, Scheme::A6] {
+            for substeps in [None, Some(3)] {
+                let whole = run_sub(scheme, dt, t_end, substeps);
+                for at in [0, 1, 17, 49] {
+                    let again = run_restarted(scheme, dt, t_end, substeps, Some(at));
+                    assert_eq!(whole.to_bits(), again.to_bits(), "{scheme:?} {substeps:?} at {at}");
+                }
+            }
+        }
+        let mut s = Staggered::new(Scheme::C0, 2);
+        let err = s.restore(|name| (name != "a_hat").then(|| vec![0.0; 2])).unwrap_err();
+        assert!(err.contains("`a_hat` is missing"), "{err}");
+        let err = s.restore(|_| Some(vec![0.0; 2])).unwrap_err();
+        assert!(err.contains("`times` holds 2 values, expected 3"), "{err}");
     }
 
     fn run(scheme: Scheme, n: usize) -> f64 {

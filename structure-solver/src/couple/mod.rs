@@ -406,7 +406,7 @@ impl Participant {
         save_state(&self.dynamics.model, &mut ck)?;
         save_dynamics(&mut ck, d)?;
         for (name, values) in self.scheme.history() {
-            ck.put(&format!("coupling.{name}"), values.to_vec())?;
+            ck.put(&format!("coupling.{name}"), values)?;
         }
         ck.write(&self.checkpoints, tag, PART)?;
         Ok(())
