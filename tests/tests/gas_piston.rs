@@ -49,9 +49,10 @@ impl GasPiston {
 }
 
 /// Angular frequency from the upward zero crossings of u - u_s (linear interpolation between
-/// samples): 2π (crossings - 1) / (last - first).
+/// samples): 2π (crossings - 1) / (last - first). The start, u = u_s to round-off, is left
+/// out: the first period includes the launch from v0.
 fn measured_frequency(series: &[(f64, f64)], u_s: f64) -> (f64, usize) {
-    let ups: Vec<f64> = series
+    let ups: Vec<f64> = series[1..]
         .windows(2)
         .filter(|w| w[0].1 - u_s < 0.0 && w[1].1 - u_s >= 0.0)
         .map(|w| {
