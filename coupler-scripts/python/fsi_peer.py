@@ -501,7 +501,7 @@ class StructurePeer:
         """The fluid's next loads: its header and an n x 3 array of nodal forces."""
         sample = self._wait(self.loads.receive, "loads from the fluid", self.timeout_s)
         header = StepHeader.from_buffer_copy(sample.user_header().contents)
-        n = sample.header().number_of_elements
+        n = sample.header.number_of_elements
         if header.count != n:
             raise Failure(CODE_PROTOCOL, f"the loads' header counts {header.count} nodes, the "
                                          f"slice holds {n}")
@@ -541,6 +541,11 @@ def serve(peer, handler):
         except Failure as f:
             reply = Reply(kind=FAILED, code=f.code, dt_stable=dt_stable)
             write_fixed_str(f.message, reply.message)
+        except (Stopped, KeyboardInterrupt):
+            raise
+        except Exception as e:  # noqa: BLE001 - a solver bug is reported, not a crash
+            reply = Reply(kind=FAILED, code=CODE_SOLVER, dt_stable=dt_stable)
+            write_fixed_str(f"internal error: {type(e).__name__}: {e}", reply.message)
         reply.wait_s = peer.waited
         reply.work_s = max(time.monotonic() - start - peer.waited, 0.0)
         peer.reply(request, reply)
