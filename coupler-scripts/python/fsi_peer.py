@@ -459,7 +459,10 @@ class StructurePeer:
             now = time.monotonic()
             if now >= deadline:
                 raise Stopped(f"no {what} within {limit_s:g} s")
-            self.listener.timed_wait(iox2.Duration.from_secs_f64(min(POLL_S, deadline - now)))
+            try:
+                self.listener.timed_wait(iox2.Duration.from_secs_f64(min(POLL_S, deadline - now)))
+            except iox2.ListenerWaitError:
+                pass  # a signal interrupted the wait: check_alive() above tells what to do
 
     def next_command(self):
         """The launcher's next command (waits 2 timeout + min(timeout, 2 s), PROTOCOL §5)."""
