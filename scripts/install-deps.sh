@@ -25,3 +25,8 @@ if command -v python3 >/dev/null; then
       || python3 -m pip install -q --disable-pip-version-check --break-system-packages meshio h5py numpy
   fi
 fi
+
+# The Python structure solver's venv (coupler-scripts/python: iceoryx2 0.10.0, numpy).
+if command -v python3 >/dev/null; then
+  bash "$(dirname "${BASH_SOURCE[0]}")/../coupler-scripts/python/install.sh"
+fi
