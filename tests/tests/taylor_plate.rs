@@ -148,4 +148,14 @@ fn taylor_plate_follows_the_acoustic_closed_form_until_cavitation() {
     let lag = taylor.p_m * case.coupling.dt / taylor.m / peak;
     println!("taylor-plate: a half-step lag would be {lag:.3e} of the peak");
     assert!(worst < 0.4 * lag, "largest error {worst:.3e} of the peak at t = {at:.3e}");
+
+    // Past cavitation the water at the wet face holds p_cut and the air pushes back with
+    // p0 + ρa ca v: m v' = p_cut - p0 - ρa ca v. The mean deceleration from t_c + 0.1 θ to t_end.
+    let after: Vec<(f64, f64)> =
+        series.iter().copied().filter(|&(t, _)| t >= t_c + 0.1 * taylor.theta).collect();
+    let ((ta, va), (tb, vb)) = (after[0], *after.last().unwrap());
+    let measured = (vb - va) / (tb - ta);
+    let expected = (taylor.p_cut - taylor.p0 - taylor.z_air * 0.5 * (va + vb)) / taylor.m;
+    println!("taylor-plate: after cavitation v' = {measured:.5} m/s² (expected {expected:.5})");
+    assert!((measured / expected - 1.0).abs() < 1e-2, "v' {measured} against {expected}");
 }
