@@ -135,7 +135,7 @@ fn taylor_plate_follows_the_acoustic_closed_form_until_cavitation() {
             (worst, at) = (e, t);
         }
     }
-    let v_c = series.iter().filter(|&&(t, _)| t <= t_c).last().unwrap();
+    let v_c = series.iter().filter(|&&(t, _)| t <= t_c).next_back().unwrap();
     println!(
         "taylor-plate: peak {peak:.5} m/s; largest error {worst:.3e} of the peak at t = {at:.3e} s; \
          v({:.4e}) = {:.5} (exact {:.5})",
@@ -147,7 +147,7 @@ fn taylor_plate_follows_the_acoustic_closed_form_until_cavitation() {
     // without the reflected wave (p_i instead of 2 p_i) is off by half, a wrong sign by all of it.
     let lag = taylor.p_m * case.coupling.dt / taylor.m / peak;
     println!("taylor-plate: a half-step lag would be {lag:.3e} of the peak");
-    assert!(worst < 0.4 * lag, "largest error {worst:.3e} of the peak at t = {at:.3e}");
+    assert!(worst < 0.1 * lag, "largest error {worst:.3e} of the peak at t = {at:.3e}");
 
     // Past cavitation the water at the wet face holds p_cut and the air pushes back with
     // p0 + ρa ca v: m v' = p_cut - p0 - ρa ca v. The mean deceleration from t_c + 0.1 θ to t_end.
@@ -157,5 +157,5 @@ fn taylor_plate_follows_the_acoustic_closed_form_until_cavitation() {
     let measured = (vb - va) / (tb - ta);
     let expected = (taylor.p_cut - taylor.p0 - taylor.z_air * 0.5 * (va + vb)) / taylor.m;
     println!("taylor-plate: after cavitation v' = {measured:.5} m/s² (expected {expected:.5})");
-    assert!((measured / expected - 1.0).abs() < 1e-2, "v' {measured} against {expected}");
+    assert!((measured / expected - 1.0).abs() < 1e-3, "v' {measured} against {expected}");
 }
