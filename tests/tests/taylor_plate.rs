@@ -135,7 +135,7 @@ fn taylor_plate_follows_the_acoustic_closed_form_until_cavitation() {
             (worst, at) = (e, t);
         }
     }
-    let v_c = series.iter().filter(|&&(t, _)| t <= t_c).next_back().unwrap();
+    let v_c = series.iter().rfind(|&&(t, _)| t <= t_c).unwrap();
     println!(
         "taylor-plate: peak {peak:.5} m/s; largest error {worst:.3e} of the peak at t = {at:.3e} s; \
          v({:.4e}) = {:.5} (exact {:.5})",
