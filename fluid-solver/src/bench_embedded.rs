@@ -24,7 +24,7 @@ use crate::embedded::advance::EmbeddedRun;
 use crate::embedded::case::Prescribed;
 use crate::embedded::fill::fill_changed;
 use crate::embedded::generate::{cylinder, plate};
-use crate::embedded::intersect::{collision, projection, Near, SurfaceAt};
+use crate::embedded::intersect::{collision, projection, SurfaceAt};
 use crate::embedded::motion::RigidMotion;
 use crate::embedded::riemann_fs::{add_wall_fluxes, WallFluxView, WallMaterial};
 use crate::embedded::status::swept_nodes_near;
@@ -52,7 +52,7 @@ const SURFACE_MACH: f64 = 0.5;
 /// Courant number of the embedded steps (the single-material row's).
 const CFL: f64 = 0.9;
 
-/// One case at one thread count (medians over the timed steps).
+/// One case at one thread count (means over the timed steps).
 #[derive(Debug, Clone, Serialize)]
 pub struct TrackingMeasurement {
     pub threads: usize,
@@ -308,7 +308,7 @@ fn track(
         parts.surface.advance(t, &x_b, &v_b);
         parts.bvh.update(&parts.surface);
         stamp("refit", &mut lap);
-        let near = Near::find(mesh, &parts.adjacency, &parts.node_boxes, &parts.bvh);
+        let near = parts.near(mesh);
         stamp("near", &mut lap);
         let cuts = parts.cuts_near(mesh, &near)?;
         stamp("intersect", &mut lap);
@@ -380,8 +380,12 @@ fn track(
         changed_nodes_per_step: mean(counts[3]),
         measurements: Vec::new(),
     };
-    let mut med = |k: &str| median(per_step.remove(k).unwrap_or_default());
-    let (step, tracking, loads) = (med("step"), med("tracking"), med("loads"));
+    // Means, not medians: the kept pairs of the tracking rebuild on some steps only.
+    let mut mean_of = |k: &str| {
+        let v = per_step.remove(k).unwrap_or_default();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    let (step, tracking, loads) = (mean_of("step"), mean_of("tracking"), mean_of("loads"));
     let threads = rayon::current_num_threads();
     let m = TrackingMeasurement {
         threads,
@@ -392,7 +396,10 @@ fn track(
         tracking_seconds: tracking,
         tracking_share: tracking / step,
         loads_seconds: loads,
-        tracking_split_seconds: split.into_iter().map(|(k, v)| (k, median(v))).collect(),
+        tracking_split_seconds: split
+            .into_iter()
+            .map(|(k, v)| (k, v.iter().sum::<f64>() / v.len().max(1) as f64))
+            .collect(),
         full_pass_seconds: full,
     };
     Ok((case, m))

@@ -10,7 +10,7 @@
 use super::adjacency::NodeEdges;
 use super::bvh::Bvh;
 use super::intersect::{
-    collision_near, projection_near, Intersections, KeptInside, Near, NodeBoxes,
+    collision_near, projection_near, Intersections, KeptInside, Near, NearSkin, NodeBoxes,
 };
 use super::intersect::{SurfaceAt, SurfaceAtError};
 use super::riemann_fs::WallPressures;
@@ -46,6 +46,8 @@ pub struct Tracker {
     pub adjacency: NodeEdges,
     /// The hierarchy over the mesh nodes' reach boxes.
     pub node_boxes: NodeBoxes,
+    /// The node-triangle pairs kept over several steps ([`NearSkin`]; not run state).
+    pub near_skin: NearSkin,
     pub tracking: Tracking,
     /// Cut edges at the end of the current step (`surface.t_b`).
     pub cuts: Intersections,
@@ -86,6 +88,7 @@ impl Tracker {
         let active = sides.status.iter().map(|s| *s == NodeStatus::Active).collect();
         let p_star = vec![[f64::NAN; 2]; cuts.cuts.len()];
         Ok(Tracker {
+            near_skin: NearSkin::new(&adjacency),
             surface,
             bvh,
             adjacency,
@@ -114,10 +117,16 @@ impl Tracker {
         }
         self.surface.advance(t_b, x_b, v_b);
         self.bvh.update(&self.surface);
-        let near = Near::find(mesh, &self.adjacency, &self.node_boxes, &self.bvh);
+        let near = self.near(mesh);
         let cuts = self.cuts_near(mesh, &near)?;
         let swept = swept_nodes_near(mesh, &self.surface, &self.bvh, &near);
         Ok(self.move_sides(mesh, cuts, &swept, &near))
+    }
+
+    /// The part of the mesh the refitted hierarchy reaches ([`Near::find`], through the kept
+    /// pairs of [`NearSkin`]).
+    pub fn near(&mut self, mesh: &Mesh) -> Near {
+        self.near_skin.find(mesh, &self.adjacency, &self.node_boxes, &self.bvh)
     }
 
     /// The cut edges of the surface at `x_b` (Alg. 4.1 or 4.2), testing the nodes and edges of
@@ -178,6 +187,7 @@ impl Tracker {
         use std::mem::size_of_val;
         self.adjacency.memory_bytes()
             + self.node_boxes.memory_bytes()
+            + self.near_skin.memory_bytes()
             + size_of_val(&self.cuts.cuts[..])
             + size_of_val(&self.cuts.occluded[..])
             + size_of_val(&self.sides.status[..])

@@ -13,10 +13,12 @@
 pub mod collision;
 pub mod near;
 pub mod projection;
+pub mod skin;
 
 pub use collision::{collision, collision_near};
 pub use near::{Near, NodeBoxes};
 pub use projection::{projection, projection_inside, projection_near, KeptInside};
+pub use skin::NearSkin;
 
 use super::bvh::Bvh;
 use super::predicates::{closest_point, segment_triangle, unit_normal, Closest};

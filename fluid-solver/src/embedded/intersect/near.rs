@@ -28,7 +28,7 @@ pub const LIST_MAX: usize = 24;
 /// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeBoxes {
-    tree: Bvh,
+    pub(super) tree: Bvh,
 }
 
 impl NodeBoxes {
@@ -85,30 +85,26 @@ impl Near {
     }
 
     /// The nodes of `boxes` whose reach boxes meet a triangle box of `bvh`, with their edges and
-    /// the triangles each reach box meets.
+    /// the triangles each reach box meets (ascending). [`super::skin::NearSkin`] gives the same
+    /// from pairs kept over several steps.
     pub fn find(mesh: &Mesh, adjacency: &NodeEdges, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
-        let pairs = boxes.tree.overlapping_pairs(bvh);
-        // The pairs sorted by node, by counting (each pair comes once).
-        let n = mesh.n_nodes();
-        let mut offsets = vec![0u32; n + 1];
-        for &[k, _] in &pairs {
-            offsets[k as usize + 1] += 1;
-        }
-        let mut nodes = Vec::new();
-        for i in 0..n {
-            if offsets[i + 1] > 0 {
-                nodes.push(i as u32);
-            }
-            offsets[i + 1] += offsets[i];
-        }
-        let mut next = offsets.clone();
-        let mut triangles = vec![0u32; pairs.len()];
-        for &[k, t] in &pairs {
-            let slot = &mut next[k as usize];
-            triangles[*slot as usize] = t;
-            *slot += 1;
-        }
+        let (offsets, triangles) =
+            group_by_node(mesh.n_nodes(), &boxes.tree.overlapping_pairs(bvh));
+        Near::from_lists(mesh, adjacency, offsets, triangles)
+    }
+
+    /// The near part from the triangle lists of every node (CSR, each list ascending): the nodes
+    /// with a non-empty list and their edges.
+    pub(super) fn from_lists(
+        mesh: &Mesh,
+        adjacency: &NodeEdges,
+        offsets: Vec<u32>,
+        triangles: Vec<u32>,
+    ) -> Near {
+        let nodes: Vec<u32> = (0..mesh.n_nodes() as u32)
+            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
+            .collect();
         // The edges of those nodes, ascending, through a bit set over the edges.
         let mut bits = vec![0u64; mesh.n_edges().div_ceil(64)];
         for &i in &nodes {
@@ -171,6 +167,29 @@ impl Near {
             _ => i,
         }
     }
+}
+
+/// Pairs `[node, triangle]` (each once) grouped by node, by counting: the offsets (one per node
+/// and one more) and each node's triangles, ascending.
+pub(super) fn group_by_node(n: usize, pairs: &[[u32; 2]]) -> (Vec<u32>, Vec<u32>) {
+    let mut offsets = vec![0u32; n + 1];
+    for &[k, _] in pairs {
+        offsets[k as usize + 1] += 1;
+    }
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut next = offsets.clone();
+    let mut triangles = vec![0u32; pairs.len()];
+    for &[k, t] in pairs {
+        let slot = &mut next[k as usize];
+        triangles[*slot as usize] = t;
+        *slot += 1;
+    }
+    for i in 0..n {
+        triangles[offsets[i] as usize..offsets[i + 1] as usize].sort_unstable();
+    }
+    (offsets, triangles)
 }
 
 #[cfg(test)]
