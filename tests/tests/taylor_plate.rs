@@ -1,5 +1,6 @@
 //! `cases/taylor-plate`: Taylor's (1941) air-backed plate through `fsi run` (real `fluid-solver`
-//! and `rigid-structure` processes, C0). A plane exponential wave p_i(t) = p_m e^{-t/θ} in water
+//! and, as the structure, `rigid-structure` (`case.toml`) or `structure-solver` with one
+//! stiff MITC4 shell free only in x (`case-shells.toml`); C0). A plane exponential wave p_i(t) = p_m e^{-t/θ} in water
 //! hits a free plate of areal mass m with air at the water's ambient pressure behind it.
 //!
 //! Acoustic theory, with the water and the air at the same ambient p0 (no static load): the wet
@@ -13,12 +14,14 @@
 //!
 //! Every parameter comes from the case file: c0 and ρ0 from the water's EOS and background state,
 //! p_m and θ from the first and last wave regions (the nodal values of the incident wave), m from
-//! the rigid mass over the column's section.
+//! the rigid mass, or the shell's ρ t times the area of its gmsh mesh, over the column's section.
 //!
-//! Build first: `cargo build --release -p coupler-scripts -p rigid-structure -p fluid-solver --bins`.
+//! Build first: `cargo build --release -p coupler-scripts -p rigid-structure -p structure-solver
+//! -p fluid-solver --bins`.
 
 use fsi_system_tests::{Fsi, Probes, Scratch};
-use interface_protocol::case::{Case, Region};
+use interface_protocol::case::{Case, Region, StructureMesh};
+use interface_protocol::io::gmsh;
 use std::path::Path;
 use std::time::Duration;
 
@@ -62,13 +65,12 @@ impl Taylor {
         let mesh = fluid.mesh.as_ref().unwrap().box_mesh.as_ref().expect("a box mesh").clone();
         let h = (mesh.hi[0] - mesh.lo[0]) / mesh.cells[0] as f64;
         let section = (mesh.hi[1] - mesh.lo[1]) * (mesh.hi[2] - mesh.lo[2]);
-        let body = case.structure.as_ref().unwrap().rigid.as_ref().unwrap();
-        let x_p = body.reference[0];
+        let (mass, x_p) = plate_mass_and_position(case);
         let ((xa, pa), (xb, pb)) = (wave[0], *wave.last().unwrap());
         let theta = (xb - xa) / (c0 * ((pb - p0) / (pa - p0)).ln());
         let p_m = (pb - p0) * ((x_p - (xb + h / 2.0)) / (c0 * theta)).exp();
         let p_cut = fluid.embedded.as_ref().and_then(|e| e.p_cut).unwrap_or(f64::NEG_INFINITY);
-        Taylor { m: body.mass / section, z_water, z_air, p0, p_m, theta, p_cut }
+        Taylor { m: mass / section, z_water, z_air, p0, p_m, theta, p_cut }
     }
 
     fn beta(&self) -> f64 {
@@ -104,9 +106,62 @@ impl Taylor {
     }
 }
 
+/// The plate's mass and its x: the rigid body's mass and reference, or the shell's ρ t times the
+/// area of its (flat, x = const) gmsh mesh and that x.
+fn plate_mass_and_position(case: &Case) -> (f64, f64) {
+    let s = case.structure.as_ref().expect("[structure]");
+    if let Some(body) = s.rigid.as_ref() {
+        return (body.mass, body.reference[0]);
+    }
+    let Some(StructureMesh::Gmsh { file, .. }) = s.mesh.as_ref() else {
+        panic!("the shell plate comes as a gmsh file");
+    };
+    let msh = gmsh::read(&case.dir().join(file), |_| Ok(())).expect("the plate mesh reads");
+    let mut area = 0.0;
+    for b in msh.blocks.iter().filter(|b| b.dim == 2) {
+        let n = b.connectivity.len() / b.len();
+        for e in b.connectivity.chunks(n) {
+            // The polygon's area in the y-z plane (the shoelace formula).
+            let p: Vec<[f64; 3]> = e.iter().map(|&k| msh.coords[k as usize]).collect();
+            area += 0.5
+                * (0..n)
+                    .map(|i| {
+                        let (a, b) = (p[i], p[(i + 1) % n]);
+                        a[1] * b[2] - b[1] * a[2]
+                    })
+                    .sum::<f64>()
+                    .abs();
+        }
+    }
+    let rho = s.material.as_ref().expect("structure.material").rho;
+    let t = s.thickness.expect("structure.thickness");
+    (rho * t * area, msh.coords[0][0])
+}
+
+/// The plate's velocity: the rigid body's `plate.vx`, or the mean `vx` of the shell's nodes (its
+/// momentum over its mass: the nodes carry equal masses).
+fn plate_velocity(p: &Probes) -> Vec<(f64, f64)> {
+    let nodes: Vec<usize> =
+        (0..p.columns.len()).filter(|&c| p.columns[c].ends_with(".vx")).collect();
+    assert!(!nodes.is_empty(), "no vx column among {:?}", p.columns);
+    p.rows
+        .iter()
+        .map(|r| (r[0], nodes.iter().map(|&c| r[c]).sum::<f64>() / nodes.len() as f64))
+        .collect()
+}
+
 #[test]
 fn taylor_plate_follows_the_acoustic_closed_form_until_cavitation() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/taylor-plate/case.toml");
+    check_taylor_plate("case.toml");
+}
+
+#[test]
+fn taylor_plate_with_a_structure_solver_shell_follows_the_closed_form() {
+    check_taylor_plate("case-shells.toml");
+}
+
+fn check_taylor_plate(file: &str) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/taylor-plate").join(file);
     let case = Case::load(&path, &[]).expect("the case parses");
     let taylor = Taylor::from_case(&case);
     let t_end = case.coupling.t_end;
@@ -124,7 +179,7 @@ fn taylor_plate_follows_the_acoustic_closed_form_until_cavitation() {
     let out = scratch.path().join("out");
     let done = Fsi::run(&scratch, &path, &out, &[]).wait(Duration::from_secs(120));
     assert!(done.status.success(), "{}", done.stderr);
-    let series = Probes::read(&out.join("structure_probes.csv")).series("plate.vx");
+    let series = plate_velocity(&Probes::read(&out.join("structure_probes.csv")));
     let last = series.last().expect("probe rows").0;
     assert!((last - t_end).abs() < 1e-12, "the run ended at {last}, not {t_end}");
     let peak = series.iter().map(|&(t, _)| taylor.velocity(t)).fold(0.0, f64::max);
