@@ -145,7 +145,7 @@ impl Handler<FluidEndpoint> for CoupledFluid<'_> {
         // The load at the start (F^0 of the schemes).
         publish_loads(ep, &run, header, self.n_nodes)?;
         self.run = Some(run);
-        // The fluid subcycles in its own CFL steps: it puts no limit on the coupling step.
+        // The fluid subcycles (CFL or fixed steps): it puts no limit on the coupling step.
         Ok(f64::INFINITY)
     }
 
