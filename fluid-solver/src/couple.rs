@@ -1,7 +1,8 @@
 //! The fluid as a coupling participant (DESIGN §1, §3, §4; PROTOCOL.md): `fluid-solver run CASE
 //! --couple RUN_ID --out DIR` joins the run, answers the launcher's commands through
 //! `participant::serve` and advances [`FluidRun`] over each `Advance` interval in its own CFL
-//! steps, the last one clipped to land on `t_to`.
+//! steps, the last one clipped to land on `t_to` (or in exactly `fluid.time.substeps` equal
+//! steps, [`crate::time::FixedSteps`]).
 //!
 //! This module only converts protocol samples to the embedded boundary's [`Surface`] and loads
 //! back (DESIGN §5.1):
@@ -145,7 +146,7 @@ impl Handler<FluidEndpoint> for CoupledFluid<'_> {
         // The load at the start (F^0 of the schemes).
         publish_loads(ep, &run, header, self.n_nodes)?;
         self.run = Some(run);
-        // The fluid subcycles in its own CFL steps: it puts no limit on the coupling step.
+        // The fluid subcycles (CFL or fixed steps): it puts no limit on the coupling step.
         Ok(f64::INFINITY)
     }
 

@@ -48,6 +48,8 @@ pub struct Problem {
     pub t_end: f64,
     /// `fluid.time.max_steps` (alone only).
     pub max_steps: Option<u64>,
+    /// `fluid.time.substeps`: equal steps per coupling interval (coupled only).
+    pub substeps: Option<u64>,
     pub probes: Vec<FluidProbe>,
     /// The probes and lines on the mesh.
     pub placed: Placed,
@@ -292,12 +294,27 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
             let time = f.time.as_ref().ok_or_else(|| {
                 field_error(case, "fluid.time", "missing: give `t_end` (a run alone needs it)")
             })?;
-            (time.t_end, "fluid.time.t_end", time.max_steps)
+            let t_end = time.t_end.ok_or_else(|| {
+                field_error(case, "fluid.time.t_end", "missing: a run alone needs its end time")
+            })?;
+            (t_end, "fluid.time.t_end", time.max_steps)
         }
         Mode::Coupled => (case.coupling.t_end, "coupling.t_end", None),
     };
+    let substeps = f.time.as_ref().and_then(|t| t.substeps);
     // A run shortened with `--set` may end before a sample it asks for: said, not refused.
     let mut warnings = Vec::new();
+    let substeps = match (mode, substeps) {
+        (Mode::Alone, Some(m)) => {
+            let message = format!(
+                "{m} steps per coupling interval apply to coupled runs; a run alone takes its \
+                 CFL steps"
+            );
+            warnings.push(case.field_error("fluid.time.substeps", message).to_string());
+            None
+        }
+        (_, m) => m,
+    };
     for (k, l) in f.lines.iter().enumerate() {
         for (j, &lt) in l.times.iter().enumerate().filter(|(_, &lt)| !reached(t_end, lt)) {
             let message = format!(
@@ -342,6 +359,7 @@ pub fn problem(case: &Case, mode: Mode) -> anyhow::Result<Problem> {
         stepping,
         t_end,
         max_steps,
+        substeps,
         probes: f.probes.clone(),
         placed,
         dt_initial,

@@ -24,7 +24,7 @@ use crate::run_report::{surface_report, write_report};
 use crate::semidiscretization::Semidiscretization;
 use crate::setup::{self, Problem};
 use crate::state::{State, Workspace};
-use crate::time::{reached, rk2_step, TimeStepping};
+use crate::time::{reached, rk2_step, FixedSteps, TimeStepping};
 use anyhow::Context;
 use interface_protocol::case::Case;
 use interface_protocol::io::checkpoint::{self, Checkpoint, Found};
@@ -118,6 +118,8 @@ pub struct FluidRun<'a> {
     stepping: TimeStepping,
     t_end: f64,
     max_steps: Option<u64>,
+    /// `fluid.time.substeps` (coupled only): equal steps per `advance_to`.
+    substeps: Option<u64>,
     state: State,
     ws: Workspace,
     step: u64,
@@ -161,6 +163,7 @@ impl<'a> FluidRun<'a> {
             stepping,
             t_end,
             max_steps,
+            substeps,
             probes,
             placed,
             level_set,
@@ -252,6 +255,7 @@ impl<'a> FluidRun<'a> {
             stepping,
             t_end,
             max_steps,
+            substeps,
             state,
             ws,
             step,
@@ -380,7 +384,9 @@ impl<'a> FluidRun<'a> {
 
     /// Advances to `t_target` in RK2 steps of the CFL step, shortened to land exactly on each
     /// line time on the way and on `t_target`, writing the outputs of every step; stops early
-    /// after `fluid.time.max_steps` steps (stand-alone runs only). Every step's state is checked
+    /// after `fluid.time.max_steps` steps (stand-alone runs only). Coupled with
+    /// `fluid.time.substeps = M`, in exactly `M` equal steps instead ([`FixedSteps`]; a step
+    /// the stable step cuts short stops the run). Every step's state is checked
     /// valid and finite; a failed step keeps the last good state (alone, as a checkpoint) and
     /// returns the error naming the step, time, node, field and values; the run then only
     /// finishes.
@@ -393,9 +399,15 @@ impl<'a> FluidRun<'a> {
             Mode::Coupled => None,
         };
         let every = &self.case.output;
+        let fixed =
+            self.substeps.map(|m| FixedSteps { substeps: m, t_from: self.t, t_to: t_target });
+        let first = self.step;
         while !reached(self.t, t_target) && limit.is_none_or(|m| self.step < m) {
             let (step, t) = (self.step, self.t);
-            let stop = self.next_stop(t_target);
+            let stop = match fixed {
+                Some(f) => f.stop(step - first),
+                None => self.next_stop(t_target),
+            };
             let start = Instant::now();
             let result = match (&mut self.embedded, &mut self.level_set) {
                 (None, Some((ls, lws))) => ls
@@ -446,6 +458,11 @@ impl<'a> FluidRun<'a> {
                     return self.fail(format!("stopped at step {}, t = {t:e}: {e}", step + 1));
                 }
             };
+            if let Some(Err(e)) = fixed.map(|f| f.check(t, stop, dt)) {
+                // The state took the stable step: the run stops there.
+                (self.t, self.step) = (t + dt, step + 1);
+                return self.fail(format!("stopped at step {}: {e}", step + 1));
+            }
             let cons = &self.state.cons[..];
             if let Err(e) = check_finite("conserved [ρ, ρu, ρv, ρw, E]", Entity::Node, t + dt, cons)
             {

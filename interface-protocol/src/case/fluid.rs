@@ -51,7 +51,10 @@
 //! cfl = 0.5
 //!
 //! [fluid.time]
-//! t_end = 0.2
+//! t_end = 0.2      # end of a run alone (a coupled run ends at coupling.t_end)
+//! max_steps = 1000 # optional: a run alone stops after this many steps
+//! substeps = 8     # optional, coupled runs: exactly 8 equal steps per coupling interval
+//!                  # instead of the CFL steps (refused, naming this key, if one is unstable)
 //! ```
 
 use super::{PistonFluid, Region};
@@ -252,15 +255,26 @@ impl Default for FluidNumerics {
     }
 }
 
-/// `[fluid.time]` (alone; coupled, the coupling step drives the fluid).
+/// `[fluid.time]`: `t_end` and `max_steps` of a run alone; `substeps` of a coupled run (where
+/// the coupling step drives the fluid).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FluidTime {
-    /// End time.
-    pub t_end: f64,
+    /// End time of a run alone (required there; a coupled run ends at `coupling.t_end`).
+    #[serde(default)]
+    pub t_end: Option<f64>,
     /// Stop after this many steps even before `t_end` (at most `resources::MAX_STEPS`).
     #[serde(default)]
     pub max_steps: Option<u64>,
+    /// Coupled runs: the fluid takes exactly this many equal steps over each coupling interval
+    /// instead of its CFL steps (so that its own time error shrinks with the coupling step, as
+    /// a temporal order study needs). A step longer than the stable step (`cfl` times the CFL
+    /// step, and the embedded surface's half-edge limit) stops the run, naming this key and
+    /// the substeps needed. Line times are then not landed on: a line is written at the end
+    /// of the first step that reaches its time. Without it the fluid subcycles in its CFL
+    /// steps, the last one clipped to land on the interval's end.
+    #[serde(default)]
+    pub substeps: Option<u64>,
 }
 
 /// A probe point.
@@ -484,7 +498,33 @@ impl FluidSection {
             ));
         }
         if let Some(t) = &self.time {
-            super::require_positive("fluid.time.t_end", t.t_end)?;
+            if let Some(t_end) = t.t_end {
+                super::require_positive("fluid.time.t_end", t_end)?;
+            }
+            let cap = crate::resources::MAX_STEPS;
+            match t.substeps {
+                Some(0) => {
+                    return Err((
+                        "fluid.time.substeps".into(),
+                        "expected at least 1 step per coupling interval, got 0".into(),
+                    ))
+                }
+                Some(m) if m > cap => {
+                    return Err((
+                        "fluid.time.substeps".into(),
+                        format!("expected at most {cap} steps per coupling interval, got {m}"),
+                    ))
+                }
+                Some(_) if n.local_time_step => {
+                    return Err((
+                        "fluid.time.substeps".into(),
+                        "fixed substeps are time accurate steps of one length for all nodes; \
+                         they cannot be combined with fluid.numerics.local_time_step = true"
+                            .into(),
+                    ))
+                }
+                _ => {}
+            }
             let cap = crate::resources::MAX_STEPS;
             if let Some(m) = t.max_steps.filter(|&m| m > cap) {
                 return Err((

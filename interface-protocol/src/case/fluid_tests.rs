@@ -87,3 +87,17 @@ fn a_named_fluid_takes_only_an_eos() {
     let e = parse("[fluid.fluids.air]\n").unwrap_err();
     assert!(e.message.contains("eos"), "{e}");
 }
+
+#[test]
+fn fixed_fluid_substeps_are_at_least_one_and_not_with_local_time_steps() {
+    let text = "[fluid.time]\nsubsteps = 8\n";
+    let t = parse(text).unwrap().fluid.unwrap().time.unwrap();
+    assert_eq!((t.substeps, t.t_end), (Some(8), None), "a coupled case needs no fluid t_end");
+    let e = parse("[fluid.time]\nsubsteps = 0\n").unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("fluid.time.substeps"), "{e}");
+    assert!(e.message.contains("at least 1"), "{e}");
+    let local = "[fluid.numerics]\nlocal_time_step = true\n[fluid.time]\nsubsteps = 4\n";
+    let e = parse(local).unwrap_err();
+    assert_eq!(e.field.as_deref(), Some("fluid.time.substeps"), "{e}");
+    assert!(e.message.contains("local_time_step"), "{e}");
+}
