@@ -27,7 +27,9 @@ use crate::solver::{FluidRun, Mode, RunOptions};
 use interface_protocol::case::Case;
 use interface_protocol::endpoint::{FluidEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
-use interface_protocol::messages::{Command, NodeLoad, NodeState, StepHeader, SurfaceElement};
+use interface_protocol::messages::{
+    capability, Command, NodeLoad, NodeState, StepHeader, SurfaceElement,
+};
 use interface_protocol::participant::{failure_code, serve, Failure, Handler, Progress};
 
 /// Relative tolerance between the fluid's time and a command's `t_from`.
@@ -243,7 +245,12 @@ impl Handler<FluidEndpoint> for CoupledFluid<'_> {
 /// Joins run `run_id` as the fluid (a `Hello` accepting any wet-surface size) and answers its
 /// commands until `Finish`.
 pub fn run(case: &Case, case_text: &str, opts: RunOptions, run_id: &str) -> anyhow::Result<()> {
-    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
+    let info = HelloInfo {
+        n_surface_nodes: 0,
+        n_surface_elements: 0,
+        case_hash: case.hash(),
+        capabilities: capability::RESTART,
+    };
     let mut endpoint =
         FluidEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))
             .map_err(|e| anyhow::anyhow!("cannot join run {run_id}: {e}"))?;

@@ -19,6 +19,7 @@ use interface_protocol::cli::{CheckArgs, RunArgs};
 use interface_protocol::endpoint::{StructureEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
 use interface_protocol::io::outdir::{OutputDir, Policy};
+use interface_protocol::messages::capability;
 use interface_protocol::participant::serve;
 use setup::Setup;
 use std::path::PathBuf;
@@ -92,6 +93,7 @@ fn run(args: &RunArgs) -> Result<(), String> {
         n_surface_nodes: solver.n_nodes() as u64,
         n_surface_elements: n_elements,
         case_hash: case.hash(),
+        capabilities: capability::RESTART,
     };
     let mut endpoint =
         StructureEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))

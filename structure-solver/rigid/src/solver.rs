@@ -474,7 +474,12 @@ mod coupled_tests {
             let (run_id, case, out) = (run_id.clone(), case.clone(), dir.path().to_path_buf());
             std::thread::spawn(move || {
                 let mut solver = solver_in(&case, &out);
-                let info = HelloInfo { n_surface_nodes: 1, n_surface_elements: 0, case_hash: 0 };
+                let info = HelloInfo {
+                    n_surface_nodes: 1,
+                    n_surface_elements: 0,
+                    case_hash: 0,
+                    capabilities: 0,
+                };
                 let mut ep = StructureEndpoint::open(&run_id, info, Timeouts::default()).unwrap();
                 serve(&mut ep, &mut solver).unwrap();
             })

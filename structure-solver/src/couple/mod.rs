@@ -22,7 +22,9 @@ use interface_protocol::handshake::HelloInfo;
 use interface_protocol::io::checkpoint::Checkpoint;
 use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::ProbeWriter;
-use interface_protocol::messages::{scheme_phase, Command, NodeLoad, NodeState, StepHeader};
+use interface_protocol::messages::{
+    capability, scheme_phase, Command, NodeLoad, NodeState, StepHeader,
+};
 use interface_protocol::participant::{failure_code, serve, Failure, Handler, Progress};
 
 use interface_protocol::io::progress::Progress as Bar;
@@ -202,6 +204,7 @@ impl Participant {
             n_surface_nodes: self.wet.nodes.len() as u64,
             n_surface_elements: self.wet.elements.len() as u64,
             case_hash: case.hash(),
+            capabilities: capability::RESTART,
         }
     }
 
