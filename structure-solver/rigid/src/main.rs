@@ -85,7 +85,15 @@ fn run(args: &RunArgs) -> Result<(), String> {
     let out = OutputDir::create(dir, policy).map_err(|e| e.to_string())?;
     let (dt, n_steps, t_end) = (setup.dt, setup.n_steps, setup.t_end);
     let n_elements = setup.body.elements.len() as u64;
-    let mut solver = solver::RigidSolver::new(setup, out)?;
+    let mut solver = match (&args.restart, &args.couple) {
+        (Some(dir), Some(_)) => solver::RigidSolver::resumed(setup, out, dir)?,
+        (Some(_), None) => {
+            return Err("--restart continues a coupled run (`fsi run --restart`); a rigid \
+                        structure alone runs from its start"
+                .into())
+        }
+        (None, _) => solver::RigidSolver::new(setup, out)?,
+    };
     let Some(run_id) = args.couple.as_deref() else {
         return solver.run_alone(dt, n_steps, t_end).map_err(|f| f.message);
     };
