@@ -9,7 +9,7 @@
 //! wrote it. `coupling.t_end` may differ: that is how a run is extended.
 
 use crate::scheme::{scheme_name, SchemeSettings};
-use interface_protocol::io::checkpoint::{self, Checkpoint, Found};
+use interface_protocol::io::checkpoint::{self, Checkpoint, Found, Search, Skipped};
 use interface_protocol::messages::{capability, Hello};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -18,7 +18,7 @@ use std::path::Path;
 pub const PART: &str = "launcher";
 
 /// The parts a common checkpoint holds.
-pub const PARTS: [&str; 3] = ["structure", "fluid", PART];
+const PARTS: [&str; 3] = ["structure", "fluid", PART];
 
 /// What the launcher's part records.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -45,14 +45,35 @@ pub fn write_part(
 /// stopped while writing one) are named on stderr.
 pub fn common_checkpoint(dir: &Path, s: &SchemeSettings) -> Result<Found, String> {
     let checkpoints = dir.join("checkpoints");
-    let search = checkpoint::search(&checkpoints, &PARTS).map_err(|e| e.to_string())?;
+    let mut tags: Vec<String> = match std::fs::read_dir(&checkpoints) {
+        Ok(entries) => entries
+            .filter_map(Result::ok)
+            .filter(|e| e.path().is_dir())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(e) => return Err(format!("{}: {e}", checkpoints.display())),
+    };
+    // The tags of `checkpoint::tag_for_step` sort by step: newest first.
+    tags.sort_unstable_by(|a, b| b.cmp(a));
+    let mut search = Search::default();
+    for tag in tags {
+        match complete(&checkpoints.join(&tag)) {
+            Ok((step, time)) => {
+                search.found = Some(Found { dir: checkpoints.join(&tag), tag, step, time });
+                break;
+            }
+            Err(reason) => search.skipped.push(Skipped { tag, reason }),
+        }
+    }
     for line in search.notices() {
         eprintln!("fsi: warning: {line}");
     }
     let Some(found) = search.found else {
         return Err(format!(
-            "--restart {}: no common checkpoint in {}: no folder there holds {} complete and at \
-             one step (checkpoints come every output.checkpoint_every coupling steps)",
+            "--restart {}: no common checkpoint in {}: no folder there holds {} complete (the \
+             structure's and the launcher's at one step); checkpoints come every \
+             output.checkpoint_every coupling steps",
             dir.display(),
             checkpoints.display(),
             PARTS.map(|p| format!("{p}.{}", checkpoint::EXTENSION)).join(", ")
@@ -86,6 +107,26 @@ pub fn common_checkpoint(dir: &Path, s: &SchemeSettings) -> Result<Found, String
         ));
     }
     Ok(found)
+}
+
+/// The step and time of the checkpoint folder `dir` if it is common: the launcher's and the
+/// structure's parts intact and at one step (both count coupling steps), the fluid's intact (it
+/// counts its own CFL steps); else why not.
+fn complete(dir: &Path) -> Result<(u64, f64), String> {
+    let read = |part: &str| {
+        Checkpoint::read_file(&dir.join(format!("{part}.{}", checkpoint::EXTENSION)))
+            .map_err(|e| e.to_string())
+    };
+    let launcher = read(PART)?;
+    let structure = read("structure")?;
+    read("fluid")?;
+    if structure.step != launcher.step {
+        return Err(format!(
+            "part `structure` is at step {}, `{PART}` at {}",
+            structure.step, launcher.step
+        ));
+    }
+    Ok((launcher.step, launcher.time))
 }
 
 /// A restart needs both participants to announce [`capability::RESTART`]; the error names the

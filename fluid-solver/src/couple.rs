@@ -108,7 +108,9 @@ fn restore_surface(
     use interface_protocol::io::checkpoint;
     let found = checkpoint::restart_point(from, crate::solver::CHECKPOINT_PART)
         .map_err(|err| solver_failure(err.into()))?
-        .ok_or_else(|| protocol_failure(format!("--restart {}: no fluid checkpoint", from.display())))?;
+        .ok_or_else(|| {
+            protocol_failure(format!("--restart {}: no fluid checkpoint", from.display()))
+        })?;
     let ck = EmbeddedCheckpoint::read(found).map_err(solver_failure)?;
     let decoded = ck.decode(&e.tracker, &e.kinematics, &semi.mesh).map_err(solver_failure)?;
     decoded.restore(e, &semi.mesh).map_err(solver_failure)

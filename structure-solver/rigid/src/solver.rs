@@ -8,11 +8,11 @@ use crate::setup::Setup;
 use interface_protocol::coupling::{Oscillators, Staggered};
 use interface_protocol::endpoint::StructureEndpoint;
 use interface_protocol::io::checkpoint::{self, Checkpoint};
-use std::path::Path;
 use interface_protocol::io::outdir::OutputDir;
 use interface_protocol::io::probes::{ProbeError, ProbeWriter};
 use interface_protocol::messages::{scheme_phase, Command, NodeLoad, StepHeader};
 use interface_protocol::participant::{failure_code, Failure, Handler, Progress};
+use std::path::Path;
 
 /// The checkpoint part the rigid structure writes: `checkpoints/<tag>/structure.ckpt`.
 pub const CHECKPOINT_PART: &str = "structure";
@@ -332,7 +332,8 @@ impl RigidSolver {
         };
         let s = &mut self.state;
         (s.u, s.v, s.a, s.v_half) = (sized("u")?, sized("v")?, sized("a")?, sized("v_half")?);
-        self.scheme.restore(|name| ck.f64(&format!("coupling.{name}")).ok().map(<[f64]>::to_vec))?;
+        self.scheme
+            .restore(|name| ck.f64(&format!("coupling.{name}")).ok().map(<[f64]>::to_vec))?;
         (self.steps, self.t) = (ck.step, ck.time);
         Ok(())
     }
