@@ -249,3 +249,31 @@ fn a_restart_without_a_matching_checkpoint_is_refused() {
     let e = fsi(&run, &args);
     assert!(e.contains("nothing to continue"), "{e}");
 }
+
+/// A participant whose `Hello` does not announce the restart capability (`piston-fluid`, which
+/// keeps no state) is refused after the handshake, by name, even where its checkpoint folder
+/// holds a fluid part.
+#[test]
+fn a_participant_that_cannot_restart_is_refused_by_name() {
+    use interface_protocol::io::checkpoint::{tag_for_step, Checkpoint};
+    let scratch = Scratch::new();
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/spring-piston/case.toml");
+    let run = scratch.path().join("run");
+    let overrides = ["output.checkpoint_every=4".to_string()];
+    let args = sets(&overrides, 8e-3);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(Fsi::run(&scratch, &case, &run, &args), "fsi run spring-piston");
+    // piston-fluid writes no part of its own; give the folder one so that the search passes.
+    let ck = run.join("checkpoints");
+    Checkpoint::new(4, 4e-3).write(&ck, &tag_for_step(4), "fluid").unwrap();
+    let id = unique_run_id("incapable");
+    let restart = sets(&overrides, 16e-3);
+    let mut args = vec!["run", case.to_str().unwrap(), "--quiet", "--run-id", &id];
+    args.extend(["--restart", run.to_str().unwrap()]);
+    args.extend(restart.iter().map(String::as_str));
+    let done = Fsi::start(&scratch, &args).wait(Duration::from_secs(30));
+    assert!(!done.status.success(), "a restart with piston-fluid succeeded");
+    let e = done.stderr;
+    assert!(e.contains("piston-fluid (fluid") && e.contains("restart capability"), "{e}");
+    assert!(!e.contains("rigid-structure (structure"), "{e}");
+}
