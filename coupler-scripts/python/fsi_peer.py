@@ -43,7 +43,7 @@ class Hello(ctypes.Structure):
         ("n_surface_nodes", ctypes.c_uint64),
         ("n_surface_elements", ctypes.c_uint64),
         ("case_hash", ctypes.c_uint64),
-        ("reserved", ctypes.c_uint64),
+        ("capabilities", ctypes.c_uint64),  # 0: no restart (PROTOCOL.md §3)
     ]
 
     @staticmethod

@@ -8,6 +8,7 @@
 
 pub mod check;
 pub mod plot;
+pub mod restart;
 pub mod run;
 pub mod scheme;
 pub mod supervise;

@@ -36,6 +36,11 @@ enum Cmd {
         /// Run id naming the run's shared memory (default: generated; for scripts and tests).
         #[arg(long)]
         run_id: Option<String>,
+        /// Continue the run in folder DIR from its newest checkpoint that both participants
+        /// wrote completely; outputs go on in DIR (probe files keep their rows up to the
+        /// checkpoint). The case and --set overrides must be the run's; coupling.t_end may grow.
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["out", "force"])]
+        restart: Option<PathBuf>,
     },
     /// Validates a case without running it: the launcher's keys, then each participant's own
     /// `check` (mesh, sets, EOS, states, probes).
@@ -68,8 +73,9 @@ enum BenchCmd {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Cmd::Run { case, out, overrides, quiet, force, run_id } => {
-            let opts = RunOptions { case_file: case, out, overrides, quiet, force, run_id };
+        Cmd::Run { case, out, overrides, quiet, force, run_id, restart } => {
+            let opts =
+                RunOptions { case_file: case, out, overrides, quiet, force, run_id, restart };
             match run(&opts) {
                 Ok(s) => {
                     if !quiet {

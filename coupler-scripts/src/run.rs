@@ -40,6 +40,9 @@ pub struct RunOptions {
     pub force: bool,
     /// Run id (services and shared-memory files); generated when `None`.
     pub run_id: Option<String>,
+    /// Continue the run in this folder from its newest common checkpoint ([`crate::restart`]);
+    /// the folder is the output folder.
+    pub restart: Option<PathBuf>,
 }
 
 /// Why a run stopped early.
@@ -119,6 +122,10 @@ struct Session<'a> {
     startup: Duration,
     solver: BTreeMap<&'static str, SolverTime>,
     bar: &'a mut Bar,
+    /// `<out>/checkpoints`, where the launcher writes its part of each checkpoint.
+    checkpoints: PathBuf,
+    /// A restart: both participants must announce the capability.
+    restart: bool,
 }
 
 /// Runs a case; `run.json` is written in the output folder whether the run completes or not.
@@ -127,28 +134,42 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     liveness::install_signal_handlers();
     let case = Case::load(&opts.case_file, &opts.overrides)?;
     let settings = SchemeSettings::of_case(&case);
-    let mut seq = Sequencer::new(settings)?;
+    let resume = match &opts.restart {
+        Some(dir) => {
+            Some(crate::restart::common_checkpoint(dir, &settings).map_err(RunError::Setup)?)
+        }
+        None => None,
+    };
+    let mut seq = match &resume {
+        Some(found) => Sequencer::resume(settings, found.step)?,
+        None => Sequencer::new(settings)?,
+    };
     let (fluid_cmd, structure_cmd) = crate::supervise::case_commands(&case);
 
     let run_id = opts.run_id.clone().unwrap_or_else(new_run_id);
     interface_protocol::services::validate_run_id(&run_id)?;
     // Before anything is created or removed: a live run with this id stays untouched.
     let _claim = shm::RunLock::acquire(&run_id)?;
-    let dir = match (&opts.out, &case.output.dir) {
-        (Some(d), _) => d.clone(),
+    let dir = match (&opts.restart, &opts.out, &case.output.dir) {
+        (Some(d), _, _) | (None, Some(d), _) => d.clone(),
         // Relative to the case file, as the participants read it.
-        (None, Some(d)) => case.dir().join(d),
-        (None, None) => default_run_dir(&opts.case_file, SystemTime::now()),
+        (None, None, Some(d)) => case.dir().join(d),
+        (None, None, None) => default_run_dir(&opts.case_file, SystemTime::now()),
     };
-    let out = OutputDir::create(&dir, Policy::from_force(opts.force))
-        .map_err(|e| RunError::Setup(e.to_string()))?;
+    // A restart continues the run in its own folder: the explicit request to write there.
+    let policy = if resume.is_some() { Policy::Existing } else { Policy::from_force(opts.force) };
+    let out = OutputDir::create(&dir, policy).map_err(|e| RunError::Setup(e.to_string()))?;
     let out_dir = std::fs::canonicalize(out.path()).unwrap_or_else(|_| out.path().to_path_buf());
     let case_file =
         std::fs::canonicalize(&opts.case_file).unwrap_or_else(|_| opts.case_file.clone());
 
     let mut bar = Bar::new(settings.t_end, opts.quiet);
+    let from = match &resume {
+        Some(f) => format!(", continued from {} at t = {:e}", f.tag, f.time),
+        None => String::new(),
+    };
     bar.println(&format!(
-        "fsi: run {run_id}: {} ({}, dt {:e}, {} steps) -> {}",
+        "fsi: run {run_id}: {} ({}, dt {:e}, {} steps{from}) -> {}",
         case.case.name,
         scheme_name(settings.scheme),
         settings.dt,
@@ -164,14 +185,17 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         startup: Duration::ZERO,
         solver: BTreeMap::new(),
         bar: &mut bar,
+        checkpoints: out_dir.join("checkpoints"),
+        restart: resume.is_some(),
     };
     let args = LaunchArgs {
         case_file: &case_file,
         run_id: &run_id,
         out_dir: &out_dir,
         overrides: &opts.overrides,
+        restart: resume.as_ref().map(|f| f.dir.as_path()),
     };
-    let mut steps = 0;
+    let mut steps = resume.as_ref().map_or(0, |f| f.step);
     let result = session
         .start(&run_id, &args, &structure_cmd, &fluid_cmd, case.hash())
         .and_then(|()| {
@@ -233,6 +257,11 @@ impl Session<'_> {
         let structure = self.hello(Role::Structure, deadline)?;
         let fluid = self.hello(Role::Fluid, deadline)?;
         LauncherLink::check(&fluid, &structure, case_hash)?;
+        if self.restart {
+            let label = |role| self.children.get(role).map_or(role.name().into(), |p| p.label());
+            let labels = [label(Role::Fluid), label(Role::Structure)];
+            crate::restart::check_capable(&fluid, &structure, labels).map_err(RunError::Setup)?;
+        }
         Ok(())
     }
 
@@ -253,8 +282,15 @@ impl Session<'_> {
                 other => other?,
             };
             self.account(role, &reply);
-            if cmd.kind == interface_protocol::messages::command_kind::FINISH {
+            use interface_protocol::messages::command_kind::{CHECKPOINT, FINISH};
+            if cmd.kind == FINISH {
                 self.children.release(role);
+            }
+            // The fluid answers a checkpoint after the structure: the launcher's part completes it.
+            if cmd.kind == CHECKPOINT && role == Role::Fluid {
+                let at = (cmd.step, cmd.t_from);
+                crate::restart::write_part(&self.checkpoints, &cmd.tag_str(), at, seq.settings())
+                    .map_err(|e| RunError::Setup(e.to_string()))?;
             }
             match progress {
                 Progress::StepDone { step, t } => {

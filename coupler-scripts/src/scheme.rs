@@ -14,6 +14,17 @@
 //! S Finish;  F Finish
 //! ```
 //!
+//! A restart from the checkpoint after k steps ([`Sequencer::resume`], `fsi run --restart`)
+//! replays neither START nor the steps before k: each participant was started with `--restart`
+//! naming the checkpoint folder and holds the state it wrote there, history included (C0's
+//! start-up half step is part of it, never redone). Init publishes that state instead of the
+//! initial one (the structure its topology and kinematics at t^k; the fluid publishes no loads,
+//! the structure reads the next ones at CORRECT of step k):
+//!
+//! ```text
+//! S Init;  F Init;  for n in k..N: (as above);  S Finish;  F Finish
+//! ```
+//!
 //! The checkpoint tag is [`checkpoint::tag_for_step`] (`step_0000000100`), the folder name a
 //! solver run alone writes too, so coupled and lone runs name checkpoints one way.
 //!
@@ -36,6 +47,8 @@ pub enum SchemeError {
     ShortLastStep { last: f64, third: f64 },
     #[error("a reply arrived from {role} while {expected} was awaited")]
     WrongRole { role: &'static str, expected: String },
+    #[error("the checkpoint after step {step} (t = {t:e}) is the end of a run to coupling.t_end = {t_end:e} ({n_steps} steps): there is nothing to continue; raise coupling.t_end")]
+    NothingToContinue { step: u64, t: f64, t_end: f64, n_steps: u64 },
 }
 
 /// What the scheme needs from the case.
@@ -84,6 +97,8 @@ pub struct Sequencer {
     stage: Stage,
     /// The command sent and not yet answered.
     pending: Option<(Role, Command)>,
+    /// A restart: the steps completed before it (no START, the first step is this one).
+    resume_at: Option<u64>,
 }
 
 /// The scheme's name as the case file spells it.
@@ -110,7 +125,7 @@ impl SchemeSettings {
 
 impl Sequencer {
     pub fn new(s: SchemeSettings) -> Result<Self, SchemeError> {
-        let seq = Sequencer { s, stage: Stage::InitStructure, pending: None };
+        let seq = Sequencer { s, stage: Stage::InitStructure, pending: None, resume_at: None };
         if s.scheme == Scheme::C0 && s.n_steps > 1 {
             // Fluid step N-1 runs from t^{N-1} + Δt/2 to t_end + Δt_last/2.
             let last = seq.step_dt(s.n_steps - 1);
@@ -118,6 +133,24 @@ impl Sequencer {
                 return Err(SchemeError::ShortLastStep { last, third: s.dt / 3.0 });
             }
         }
+        Ok(seq)
+    }
+
+    /// The sequence of a restart from the checkpoint after `step` completed steps (see the
+    /// module doc): Init to both, then step `step`. A checkpoint at or past the last step has
+    /// nothing to continue.
+    pub fn resume(s: SchemeSettings, step: u64) -> Result<Self, SchemeError> {
+        let mut seq = Sequencer::new(s)?;
+        if step >= s.n_steps {
+            let t = step as f64 * s.dt;
+            return Err(SchemeError::NothingToContinue {
+                step,
+                t,
+                t_end: s.t_end,
+                n_steps: s.n_steps,
+            });
+        }
+        seq.resume_at = Some(step);
         Ok(seq)
     }
 
@@ -239,7 +272,10 @@ impl Sequencer {
         let first_step = if n_steps == 0 { Stage::FinishStructure } else { Stage::Predict(0) };
         let next = match stage {
             Stage::InitStructure => Stage::InitFluid,
-            Stage::InitFluid => Stage::StartStructure,
+            Stage::InitFluid => match self.resume_at {
+                Some(k) => Stage::Predict(k),
+                None => Stage::StartStructure,
+            },
             Stage::StartStructure if self.s.scheme == Scheme::C0 => Stage::StartFluid,
             Stage::StartStructure | Stage::StartFluid => first_step,
             Stage::Predict(n) => Stage::Fluid(n),
@@ -363,6 +399,42 @@ mod tests {
     golden!(css_short_last_step_matches_golden, "css_short_last.trace", Scheme::Css, 0.1, 0.25, 3);
     golden!(c0_short_last_step_matches_golden, "c0_short_last.trace", Scheme::C0, 0.1, 0.25, 3);
     golden!(a6_short_last_step_matches_golden, "a6_short_last.trace", Scheme::A6, 0.1, 0.25, 3);
+
+    /// The commands of a run restarted after `k` steps are those of the whole run from step k
+    /// on, after the two Inits: no START, C0's start-up half step not redone.
+    #[test]
+    fn a_resumed_sequence_is_the_tail_of_the_whole_one() {
+        for scheme in [Scheme::Css, Scheme::C0, Scheme::A6] {
+            let s = settings(scheme, 0.1, 0.5, 2);
+            let whole = run(s);
+            for k in [2, 4] {
+                let mut seq = Sequencer::resume(s, k).unwrap();
+                let mut got = Vec::new();
+                while let Some((role, cmd)) = seq.next_command() {
+                    got.push((role, cmd));
+                    let kind = if cmd.kind == command_kind::INIT {
+                        reply_kind::READY
+                    } else {
+                        reply_kind::DONE
+                    };
+                    seq.accept(role, &reply(kind)).unwrap();
+                }
+                let first = whole
+                    .iter()
+                    .position(|(r, c)| {
+                        *r == Role::Structure
+                            && c.scheme_phase == scheme_phase::PREDICT
+                            && c.step == k
+                    })
+                    .unwrap();
+                assert_eq!(got[..2], whole[..2], "{scheme:?} from {k}: the Inits");
+                assert_eq!(got[2..], whole[first..], "{scheme:?} from {k}");
+                assert!(got.iter().all(|(_, c)| c.scheme_phase != scheme_phase::START));
+            }
+            let e = Sequencer::resume(s, 5).unwrap_err().to_string();
+            assert!(e.contains("nothing to continue") && e.contains("coupling.t_end"), "{e}");
+        }
+    }
 
     #[test]
     fn steps_are_reported_once_each_with_their_end_time() {

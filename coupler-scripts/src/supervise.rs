@@ -75,6 +75,8 @@ pub struct LaunchArgs<'a> {
     pub run_id: &'a str,
     pub out_dir: &'a Path,
     pub overrides: &'a [String],
+    /// A restart: the checkpoint folder each participant continues from (`--restart`).
+    pub restart: Option<&'a Path>,
 }
 
 /// One running participant.
@@ -133,7 +135,7 @@ pub fn signal_group(pgid: u32, signal: libc::c_int) {
 
 impl Participant {
     /// Starts `command` (the case's `[<role>] command`) as
-    /// `<command...> run <case> --couple <run_id> --out <dir> [--set k=v]...`.
+    /// `<command...> run <case> --couple <run_id> --out <dir> [--set k=v]... [--restart ckpt]`.
     pub fn spawn(role: Role, command: &[String], args: &LaunchArgs) -> Result<Self, SpawnError> {
         let (name, program, mut cmd) = participant_command(role, command)?;
         cmd.arg("run")
@@ -144,6 +146,9 @@ impl Participant {
             .arg(args.out_dir);
         for o in args.overrides {
             cmd.arg("--set").arg(o);
+        }
+        if let Some(dir) = args.restart {
+            cmd.arg("--restart").arg(dir);
         }
         cmd.env(LAUNCHER_PID_ENV, std::process::id().to_string());
         let child = cmd.spawn().map_err(|source| SpawnError::Spawn {
@@ -328,7 +333,13 @@ mod tests {
     use super::*;
 
     fn args<'a>(dir: &'a Path, overrides: &'a [String]) -> LaunchArgs<'a> {
-        LaunchArgs { case_file: Path::new("case.toml"), run_id: "t1", out_dir: dir, overrides }
+        LaunchArgs {
+            case_file: Path::new("case.toml"),
+            run_id: "t1",
+            out_dir: dir,
+            overrides,
+            restart: None,
+        }
     }
 
     #[test]

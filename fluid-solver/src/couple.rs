@@ -28,7 +28,9 @@ use crate::solver::{FluidRun, Mode, RunOptions};
 use interface_protocol::case::Case;
 use interface_protocol::endpoint::{FluidEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
-use interface_protocol::messages::{Command, NodeLoad, NodeState, StepHeader, SurfaceElement};
+use interface_protocol::messages::{
+    capability, Command, NodeLoad, NodeState, StepHeader, SurfaceElement,
+};
 use interface_protocol::participant::{failure_code, serve, Failure, Handler, Progress};
 
 /// Relative tolerance between the fluid's time and a command's `t_from`.
@@ -94,6 +96,27 @@ fn publish_loads(
     result.map_err(solver_failure)
 }
 
+/// A coupled restart: the surface state of the checkpoint `--restart from` names (node status
+/// and sides, `(x, v)` at both ends of the last step, the Hermite path, `p*`, loads), checked
+/// against the surface the structure published at `Init`; the kinematics published then (the
+/// structure's state at t^k) are not the fluid's own copy (C0 and A6 run the fluid off t^k).
+fn restore_surface(
+    e: &mut EmbeddedRun,
+    from: &std::path::Path,
+    semi: &crate::semidiscretization::Semidiscretization,
+) -> Result<(), Failure> {
+    use crate::embedded::checkpoint::EmbeddedCheckpoint;
+    use interface_protocol::io::checkpoint;
+    let found = checkpoint::restart_point(from, crate::solver::CHECKPOINT_PART)
+        .map_err(|err| solver_failure(err.into()))?
+        .ok_or_else(|| {
+            protocol_failure(format!("--restart {}: no fluid checkpoint", from.display()))
+        })?;
+    let ck = EmbeddedCheckpoint::read(found).map_err(solver_failure)?;
+    let decoded = ck.decode(&e.tracker, &e.kinematics, &semi.mesh).map_err(solver_failure)?;
+    decoded.restore(e, &semi.mesh).map_err(solver_failure)
+}
+
 impl Handler<FluidEndpoint> for CoupledFluid<'_> {
     fn init(&mut self, ep: &mut FluidEndpoint) -> Result<f64, Failure> {
         let (version, elements) = ep.read_topology(|h: &StepHeader, e: &[SurfaceElement]| {
@@ -136,15 +159,23 @@ impl Handler<FluidEndpoint> for CoupledFluid<'_> {
             let dir = run.out_dir().to_path_buf();
             let mut e = EmbeddedRun::with(s.tracker, at_rest, s.loads, s.interface, s.p_cut, &dir)
                 .map_err(solver_failure)?;
-            e.start_pressures(run.semidiscretization(), run.primitives())
-                .map_err(solver_failure)?;
+            match &self.opts.restart {
+                Some(from) => restore_surface(&mut e, from, run.semidiscretization())?,
+                None => e
+                    .start_pressures(run.semidiscretization(), run.primitives())
+                    .map_err(solver_failure)?,
+            }
             run.embed(e);
         }
         self.topology_version = version;
         self.n_nodes = run.embedded().map_or(0, |e| e.tracker.surface.n_nodes());
-        let header = StepHeader { step: 0, time: t0, dt: 0.0, topology_version: version, count: 0 };
-        // The load at the start (F^0 of the schemes).
-        publish_loads(ep, &run, header, self.n_nodes)?;
+        if self.opts.restart.is_none() {
+            let header =
+                StepHeader { step: 0, time: t0, dt: 0.0, topology_version: version, count: 0 };
+            // The load at the start (F^0 of the schemes). A restart publishes none: the
+            // structure reads the next loads at CORRECT (PROTOCOL.md §4, restart).
+            publish_loads(ep, &run, header, self.n_nodes)?;
+        }
         self.run = Some(run);
         // The fluid subcycles (CFL or fixed steps): it puts no limit on the coupling step.
         Ok(f64::INFINITY)
@@ -244,7 +275,12 @@ impl Handler<FluidEndpoint> for CoupledFluid<'_> {
 /// Joins run `run_id` as the fluid (a `Hello` accepting any wet-surface size) and answers its
 /// commands until `Finish`.
 pub fn run(case: &Case, case_text: &str, opts: RunOptions, run_id: &str) -> anyhow::Result<()> {
-    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
+    let info = HelloInfo {
+        n_surface_nodes: 0,
+        n_surface_elements: 0,
+        case_hash: case.hash(),
+        capabilities: capability::RESTART,
+    };
     let mut endpoint =
         FluidEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))
             .map_err(|e| anyhow::anyhow!("cannot join run {run_id}: {e}"))?;

@@ -26,9 +26,6 @@ enum Command {
     Run {
         #[command(flatten)]
         args: RunArgs,
-        /// Continue from the newest checkpoint of this previous run folder.
-        #[arg(long)]
-        restart: Option<PathBuf>,
     },
     /// Set a case up as `run` would (mesh, boundaries, EOS, states, probes, lines, time step),
     /// print a summary and exit without running or writing anything.
@@ -62,7 +59,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { args, restart } => run(&args, restart),
+        Command::Run { args } => run(&args),
         Command::Check { args } => args.load_case().map_err(anyhow::Error::from).and_then(|case| {
             let checked = check::check(&case)?;
             print!("{}", checked.summary);
@@ -94,11 +91,12 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(args: &RunArgs, restart: Option<PathBuf>) -> anyhow::Result<()> {
+fn run(args: &RunArgs) -> anyhow::Result<()> {
     let case = args.load_case()?;
     let text = std::fs::read_to_string(&args.case)?;
     let out = args.out_dir(&case, || outdir::default_run_dir(&args.case, SystemTime::now()));
     let quiet = args.quiet;
+    let restart = args.restart.clone();
     let opts = solver::RunOptions { out: out.clone(), quiet, restart, force: args.force };
     if let Some(run_id) = &args.couple {
         return couple::run(&case, &text, opts, run_id);

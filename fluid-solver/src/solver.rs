@@ -59,13 +59,14 @@ pub struct RunSummary {
     pub nodes: usize,
 }
 
-/// Reads the conserved state, node materials and level set of the newest checkpoint under
-/// `run_dir/checkpoints` (a checkpoint without `material` is of one fluid, material 0; one
-/// without `phi` has no level set).
+/// Reads the conserved state, node materials and level set of the checkpoint `--restart
+/// run_dir` names: the newest complete one under `run_dir/checkpoints`, or `run_dir` itself
+/// when it is one checkpoint folder ([`checkpoint::restart_point`]). A checkpoint without
+/// `material` is of one fluid, material 0; one without `phi` has no level set.
 pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State, u64, f64)> {
-    let dir = run_dir.join("checkpoints");
-    let found = checkpoint::latest(&dir, &[CHECKPOINT_PART])?
-        .with_context(|| format!("no complete fluid checkpoint in {}", dir.display()))?;
+    let found = checkpoint::restart_point(run_dir, CHECKPOINT_PART)?.with_context(|| {
+        format!("no complete fluid checkpoint in {}", run_dir.join("checkpoints").display())
+    })?;
     read_fluid_part(&found, n_nodes)
 }
 
@@ -242,7 +243,9 @@ impl<'a> FluidRun<'a> {
 
         let fields = output::create_writer(out.path(), &semi.mesh)?;
         let names: Vec<&str> = probes.iter().map(|p| p.name.as_str()).collect();
-        let probe_csv = ProbeWriter::fluid(out.path(), &names)?;
+        // A coupled restart continues the run's probe file, which holds the row at `t` already.
+        let resumed = mode == Mode::Coupled && opts.restart.is_some();
+        let probe_csv = ProbeWriter::fluid_from(out.path(), &names, resumed.then_some(t))?;
         let bar = Progress::new(t_end, opts.quiet || mode == Mode::Coupled);
         let mut run = FluidRun {
             case,
@@ -274,7 +277,9 @@ impl<'a> FluidRun<'a> {
             cavitation_clips: 0,
         };
         run.write_field_step()?;
-        run.write_probes()?;
+        if !resumed {
+            run.write_probes()?;
+        }
         // Lines asked for at the start time.
         run.write_due_lines()?;
         Ok(run)

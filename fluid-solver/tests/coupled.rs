@@ -155,7 +155,12 @@ fn start_coupled(
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
+    let info = HelloInfo {
+        n_surface_nodes: 0,
+        n_surface_elements: 0,
+        case_hash: case.hash(),
+        capabilities: 0,
+    };
     let structure = StructureEndpoint::open(&id, info, timeouts).unwrap();
     let soon = Instant::now() + Duration::from_secs(10);
     let f = link.wait_hello(Role::Fluid, soon).unwrap();

@@ -73,7 +73,12 @@ fn load_of(s: &NodeState) -> NodeLoad {
 
 fn iceoryx2_round_trips(run_id: &str, n: usize, repeats: usize) -> Result<Vec<f64>, ProtocolError> {
     let id = format!("{run_id}-n{n}");
-    let info = HelloInfo { n_surface_nodes: n as u64, n_surface_elements: 0, case_hash: 0 };
+    let info = HelloInfo {
+        n_surface_nodes: n as u64,
+        n_surface_elements: 0,
+        case_hash: 0,
+        capabilities: 0,
+    };
     let timeouts = Timeouts::default();
     let result = (|| {
         let mut s = StructureEndpoint::open(&id, info, timeouts)?;

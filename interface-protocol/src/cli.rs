@@ -1,5 +1,6 @@
 //! The command line every participant accepts, so the launcher can start any of them the same
-//! way (DESIGN §1): `<solver> run CASE [--couple RUN_ID] [--out DIR] [--set KEY=VALUE]... [--quiet]`.
+//! way (DESIGN §1): `<solver> run CASE [--couple RUN_ID] [--out DIR] [--set KEY=VALUE]... [--quiet]
+//! [--force] [--restart DIR]`.
 //! A solver flattens `RunArgs` into its own `run` subcommand and adds what only it has, and
 //! offers `<solver> check CASE [--set KEY=VALUE]...` ([`CheckArgs`]): everything `run` does before
 //! its first step (mesh, sets, EOS, states, probes), then exit 0, or an error naming the file,
@@ -30,6 +31,12 @@ pub struct RunArgs {
     /// Without it a non-empty output folder is refused (never overwritten silently).
     #[arg(long)]
     pub force: bool,
+    /// Continue from a checkpoint: a run folder (its newest complete checkpoint of this
+    /// participant) or one checkpoint folder `<run>/checkpoints/<tag>` (that one; what `fsi run
+    /// --restart` passes each participant, the newest checkpoint both wrote). See
+    /// `io::checkpoint::restart_point`.
+    #[arg(long, value_name = "DIR")]
+    pub restart: Option<PathBuf>,
 }
 
 /// Arguments of `check`, common to every participant.
@@ -86,6 +93,7 @@ mod tests {
         assert_eq!(cli.run.set, ["a.b=1", "c=2"]);
         assert!(!cli.run.quiet);
         assert!(!cli.run.force);
+        assert_eq!(cli.run.restart, None);
         let forced = Cli::try_parse_from(["x", "c.toml", "--force"]).unwrap();
         assert!(forced.run.force);
     }

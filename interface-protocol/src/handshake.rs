@@ -16,6 +16,8 @@ pub struct HelloInfo {
     pub n_surface_elements: u64,
     /// `case::Case::hash()` of the case the participant loaded.
     pub case_hash: u64,
+    /// Bits of `messages::capability` (0: the base sequence only).
+    pub capabilities: u64,
 }
 
 impl HelloInfo {
@@ -29,7 +31,7 @@ impl HelloInfo {
             n_surface_nodes: self.n_surface_nodes,
             n_surface_elements: self.n_surface_elements,
             case_hash: self.case_hash,
-            reserved: 0,
+            capabilities: self.capabilities,
         }
     }
 }
@@ -171,7 +173,8 @@ mod tests {
     use super::*;
 
     fn hellos() -> (Hello, Hello) {
-        let s = HelloInfo { n_surface_nodes: 4, n_surface_elements: 2, case_hash: 7 };
+        let s =
+            HelloInfo { n_surface_nodes: 4, n_surface_elements: 2, case_hash: 7, capabilities: 0 };
         let f = HelloInfo { n_surface_nodes: 0, ..s };
         (f.hello(Role::Fluid), s.hello(Role::Structure))
     }

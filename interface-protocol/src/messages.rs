@@ -49,7 +49,7 @@ pub const UNITS_SI: u32 = 0;
 ///
 /// Layout (48 bytes, align 8): `0:u32 protocol_version, 4:u32 role (1 fluid, 2 structure),
 /// 8:u32 pid, 12:u32 units, 16:u64 n_surface_nodes, 24:u64 n_surface_elements, 32:u64 case_hash,
-/// 40:u64 reserved`.
+/// 40:u64 capabilities` (bits of [`capability`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ZeroCopySend)]
 #[type_name("fsi::Hello::v1")]
 #[repr(C)]
@@ -64,7 +64,15 @@ pub struct Hello {
     pub n_surface_elements: u64,
     /// 64-bit FNV-1a hash of the effective case (see `case::Case::hash`).
     pub case_hash: u64,
-    pub reserved: u64,
+    /// What the participant supports beyond the base sequence: bits of [`capability`].
+    pub capabilities: u64,
+}
+
+/// Bits of `Hello::capabilities`.
+pub mod capability {
+    /// The participant continues a run from a checkpoint (`run --restart DIR`, the restart
+    /// sequence of PROTOCOL.md §4): a launcher refuses a restart with a participant without it.
+    pub const RESTART: u64 = 1;
 }
 
 /// Kinds of `Command::kind`.

@@ -20,9 +20,6 @@ enum Command {
     Run {
         #[command(flatten)]
         args: RunArgs,
-        /// Resume a run alone from the newest checkpoint in this run folder.
-        #[arg(long)]
-        restart: Option<std::path::PathBuf>,
     },
     /// Does everything `run` does before the first step (mesh and its checks, sets, parts,
     /// BCs, loads, probes, the stable step; coupled cases: the wet surface), prints a summary
@@ -63,15 +60,10 @@ fn main() {
     let cli = Cli::parse();
     log_warnings();
     let result = match cli.command {
-        Command::Run { args: RunArgs { couple: Some(_), .. }, restart: Some(_) } => {
-            Err(anyhow::anyhow!(
-                "--restart applies to runs alone; the launcher drives a coupled run from its start"
-            ))
-        }
         Command::Run {
-            args: RunArgs { case, out, set, quiet, couple: Some(run_id), .. }, ..
-        } => structure_solver::couple::run(&case, &run_id, out, &set, quiet),
-        Command::Run { args: RunArgs { case, out, set, quiet, force, couple: None }, restart } => {
+            args: RunArgs { case, out, set, quiet, couple: Some(run_id), restart, .. },
+        } => structure_solver::couple::run(&case, &run_id, out, &set, quiet, restart.as_deref()),
+        Command::Run { args: RunArgs { case, out, set, quiet, force, couple: None, restart } } => {
             structure_solver::run::run(&structure_solver::run::RunOptions {
                 case,
                 out,

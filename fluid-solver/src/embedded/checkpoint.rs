@@ -252,9 +252,17 @@ pub fn latest(run_dir: &Path, fluid_part: &str) -> anyhow::Result<EmbeddedCheckp
             None => anyhow::anyhow!("no complete fluid checkpoint in {}", dir.display()),
         });
     };
-    let path = part_path(&found.dir);
-    let ck = Checkpoint::read_file(&path)?;
-    Ok(EmbeddedCheckpoint { found, path, ck })
+    EmbeddedCheckpoint::read(found)
+}
+
+impl EmbeddedCheckpoint {
+    /// The embedded part of the checkpoint folder `found` (a coupled restart's, named by the
+    /// launcher).
+    pub fn read(found: Found) -> anyhow::Result<EmbeddedCheckpoint> {
+        let path = part_path(&found.dir);
+        let ck = Checkpoint::read_file(&path)?;
+        Ok(EmbeddedCheckpoint { found, path, ck })
+    }
 }
 
 /// The embedded part of a checkpoint checked against the case, ready to restore.

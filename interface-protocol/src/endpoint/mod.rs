@@ -13,7 +13,7 @@
 //! use interface_protocol::messages::{NodeLoad, NodeState, StepHeader};
 //! use interface_protocol::handshake::HelloInfo;
 //!
-//! let info = HelloInfo { n_surface_nodes: 2, n_surface_elements: 0, case_hash: 42 };
+//! let info = HelloInfo { n_surface_nodes: 2, n_surface_elements: 0, case_hash: 42, capabilities: 0 };
 //! let mut s = StructureEndpoint::open("run-1", info, Timeouts::default())?;
 //! let mut f = FluidEndpoint::open("run-1", info, Timeouts::default())?;
 //! let header = StepHeader { step: 0, time: 0.0, dt: 1e-3, topology_version: 1, count: 0 };

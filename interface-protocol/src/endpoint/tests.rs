@@ -27,7 +27,12 @@ fn quick() -> Timeouts {
 fn fluid_and_structure_exchange_ten_thousand_nodes_then_leave_no_file() {
     let id = run_id("exchange");
     const N: usize = 10_000;
-    let info = HelloInfo { n_surface_nodes: N as u64, n_surface_elements: 1, case_hash: 5 };
+    let info = HelloInfo {
+        n_surface_nodes: N as u64,
+        n_surface_elements: 1,
+        case_hash: 5,
+        capabilities: 0,
+    };
     let mut link = LauncherLink::open(&id, quick()).unwrap();
     // Both sides subscribe before either publishes, as after the launcher's handshake.
     let both_open = std::sync::Arc::new(std::sync::Barrier::new(2));

@@ -27,7 +27,7 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 mod search;
-pub use search::{latest, search, Found, Search, Skipped};
+pub use search::{latest, restart_point, search, Found, Search, Skipped};
 
 const MAGIC: &[u8; 8] = b"FSICKPT\0";
 const VERSION: u32 = 1;

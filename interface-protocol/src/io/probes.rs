@@ -35,6 +35,8 @@ pub enum ProbeError {
          got {got}"
     )]
     RowLength { path: PathBuf, expected: usize, got: usize, probes: usize, components: usize },
+    #[error("{path}: cannot continue it from t = {t:e}: {reason}")]
+    Resume { path: PathBuf, t: f64, reason: String },
 }
 
 /// Refuses a probe name that would break the CSV header (empty, or holding `,`, `"` or a line
@@ -63,18 +65,46 @@ impl ProbeWriter {
         probes: &[S],
         components: &[&str],
     ) -> Result<Self, ProbeError> {
+        Self::open(path, probes, components, None)
+    }
+
+    /// Reopens `path` for a run continued from a checkpoint at time `t` (a restart): the file
+    /// must start with the header of `probes` x `components`; its rows up to `t` stay, the rows
+    /// after `t` (written past the checkpoint by the run that stopped) are dropped, and new rows
+    /// follow. So the continued file holds each time once, as an uninterrupted run writes it.
+    pub fn resume<S: AsRef<str>>(
+        path: &Path,
+        probes: &[S],
+        components: &[&str],
+        t: f64,
+    ) -> Result<Self, ProbeError> {
+        Self::open(path, probes, components, Some(t))
+    }
+
+    /// [`ProbeWriter::create`], or with `keep_until` [`ProbeWriter::resume`].
+    fn open<S: AsRef<str>>(
+        path: &Path,
+        probes: &[S],
+        components: &[&str],
+        keep_until: Option<f64>,
+    ) -> Result<Self, ProbeError> {
         for name in probes {
             check_probe_name(name.as_ref())?;
         }
         let io_err = |source| ProbeError::Io { path: path.to_path_buf(), source };
-        let mut out = BufWriter::new(File::create(path).map_err(io_err)?);
         let mut header = String::from("time");
         for p in probes {
             for c in components {
                 header.push_str(&format!(",{}.{c}", p.as_ref()));
             }
         }
+        let kept = match keep_until {
+            Some(t) => rows_until(path, &header, t)?,
+            None => String::new(),
+        };
+        let mut out = BufWriter::new(File::create(path).map_err(io_err)?);
         writeln!(out, "{header}").map_err(io_err)?;
+        out.write_all(kept.as_bytes()).map_err(io_err)?;
         out.flush().map_err(io_err)?;
         Ok(Self {
             out,
@@ -93,6 +123,26 @@ impl ProbeWriter {
     /// `structure_probes.csv` in `dir` with [`STRUCTURE_COMPONENTS`].
     pub fn structure<S: AsRef<str>>(dir: &Path, probes: &[S]) -> Result<Self, ProbeError> {
         Self::create(&dir.join("structure_probes.csv"), probes, STRUCTURE_COMPONENTS)
+    }
+
+    /// [`ProbeWriter::fluid`], continued from `t` when `resume_at` says so
+    /// ([`ProbeWriter::resume`]).
+    pub fn fluid_from<S: AsRef<str>>(
+        dir: &Path,
+        probes: &[S],
+        resume_at: Option<f64>,
+    ) -> Result<Self, ProbeError> {
+        Self::open(&dir.join("probes.csv"), probes, FLUID_COMPONENTS, resume_at)
+    }
+
+    /// [`ProbeWriter::structure`], continued from `t` when `resume_at` says so
+    /// ([`ProbeWriter::resume`]).
+    pub fn structure_from<S: AsRef<str>>(
+        dir: &Path,
+        probes: &[S],
+        resume_at: Option<f64>,
+    ) -> Result<Self, ProbeError> {
+        Self::open(&dir.join("structure_probes.csv"), probes, STRUCTURE_COMPONENTS, resume_at)
     }
 
     /// Appends one row: `values` holds the components of probe 0, then probe 1, ...
@@ -136,6 +186,30 @@ impl Drop for ProbeWriter {
             tracing::warn!("{}: could not flush probe rows: {e}", self.path.display());
         }
     }
+}
+
+/// The rows of the probe file `path` whose time is at most `t`, each with its line break; the
+/// file must begin with `header`. A row whose time cannot be read is an error naming its line.
+fn rows_until(path: &Path, header: &str, t: f64) -> Result<String, ProbeError> {
+    let fail = |reason: String| ProbeError::Resume { path: path.to_path_buf(), t, reason };
+    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
+    let mut lines = text.lines();
+    let found = lines.next().unwrap_or_default();
+    if found != header {
+        return Err(fail(format!("its header is `{found}`, the case's probes give `{header}`")));
+    }
+    let mut kept = String::new();
+    for (i, line) in lines.enumerate() {
+        let time = line.split(',').next().unwrap_or_default();
+        let time: f64 =
+            time.parse().map_err(|_| fail(format!("line {}: `{time}` is not a time", i + 2)))?;
+        if time > t {
+            break;
+        }
+        kept.push_str(line);
+        kept.push('\n');
+    }
+    Ok(kept)
 }
 
 fn push_number(s: &mut String, v: f64) {
@@ -197,6 +271,32 @@ mod tests {
 
     fn parse(text: &str) -> Vec<Vec<f64>> {
         text.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect()
+    }
+
+    #[test]
+    fn a_resumed_file_keeps_the_rows_up_to_the_restart_time_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("structure_probes.csv");
+        let mut w = ProbeWriter::structure(dir.path(), &["tip"]).unwrap();
+        for k in 0..6 {
+            w.write_row(k as f64 * 0.1, &[k as f64; 6]).unwrap();
+        }
+        drop(w);
+        // Restarted at t^3 = 0.30000000000000004: rows 0..=3 stay, 4 and 5 go, new rows follow.
+        let mut w = ProbeWriter::structure_from(dir.path(), &["tip"], Some(3.0 * 0.1)).unwrap();
+        w.write_row(0.4, &[-4.0; 6]).unwrap();
+        drop(w);
+        let rows = parse(&std::fs::read_to_string(&path).unwrap());
+        let times: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+        assert_eq!(times, [0.0, 0.1, 0.2, 3.0 * 0.1, 0.4]);
+        assert_eq!(rows[3][1], 3.0);
+        assert_eq!(rows[4][1], -4.0);
+        // Another case's probes: the header differs, and the file is left as it was.
+        let before = std::fs::read_to_string(&path).unwrap();
+        let e = ProbeWriter::structure_from(dir.path(), &["root"], Some(0.2)).err().unwrap();
+        let e = e.to_string();
+        assert!(e.contains("structure_probes.csv") && e.contains("time,tip.ux"), "{e}");
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), before);
     }
 
     #[test]

@@ -19,6 +19,7 @@ use interface_protocol::cli::{CheckArgs, RunArgs};
 use interface_protocol::endpoint::{StructureEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
 use interface_protocol::io::outdir::{OutputDir, Policy};
+use interface_protocol::messages::capability;
 use interface_protocol::participant::serve;
 use setup::Setup;
 use std::path::PathBuf;
@@ -84,7 +85,15 @@ fn run(args: &RunArgs) -> Result<(), String> {
     let out = OutputDir::create(dir, policy).map_err(|e| e.to_string())?;
     let (dt, n_steps, t_end) = (setup.dt, setup.n_steps, setup.t_end);
     let n_elements = setup.body.elements.len() as u64;
-    let mut solver = solver::RigidSolver::new(setup, out)?;
+    let mut solver = match (&args.restart, &args.couple) {
+        (Some(dir), Some(_)) => solver::RigidSolver::resumed(setup, out, dir)?,
+        (Some(_), None) => {
+            return Err("--restart continues a coupled run (`fsi run --restart`); a rigid \
+                        structure alone runs from its start"
+                .into())
+        }
+        (None, _) => solver::RigidSolver::new(setup, out)?,
+    };
     let Some(run_id) = args.couple.as_deref() else {
         return solver.run_alone(dt, n_steps, t_end).map_err(|f| f.message);
     };
@@ -92,6 +101,7 @@ fn run(args: &RunArgs) -> Result<(), String> {
         n_surface_nodes: solver.n_nodes() as u64,
         n_surface_elements: n_elements,
         case_hash: case.hash(),
+        capabilities: capability::RESTART,
     };
     let mut endpoint =
         StructureEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))

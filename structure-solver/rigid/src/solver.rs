@@ -7,11 +7,14 @@ use crate::model::Body;
 use crate::setup::Setup;
 use interface_protocol::coupling::{Oscillators, Staggered};
 use interface_protocol::endpoint::StructureEndpoint;
-use interface_protocol::io::checkpoint::Checkpoint;
+use interface_protocol::io::checkpoint::{self, Checkpoint};
 use interface_protocol::io::outdir::OutputDir;
 use interface_protocol::io::probes::{ProbeError, ProbeWriter};
 use interface_protocol::messages::{scheme_phase, Command, NodeLoad, StepHeader};
 use interface_protocol::participant::{failure_code, Failure, Handler, Progress};
+use std::path::Path;
+
+mod restart_state;
 
 /// The checkpoint part the rigid structure writes: `checkpoints/<tag>/structure.ckpt`.
 pub const CHECKPOINT_PART: &str = "structure";
@@ -46,12 +49,31 @@ fn probe_failure(e: ProbeError) -> Failure {
 impl RigidSolver {
     /// The solver of a case's setup, writing `structure_probes.csv` and checkpoints into `out`.
     pub fn new(setup: Setup, out: OutputDir) -> Result<RigidSolver, String> {
+        Self::open(setup, out, None)
+    }
+
+    /// The solver continuing a coupled run from the checkpoint `--restart dir` names
+    /// (`checkpoint::restart_point`): the state, the scheme's history and the step restored,
+    /// `structure_probes.csv` kept up to the checkpoint's time.
+    pub fn resumed(setup: Setup, out: OutputDir, dir: &Path) -> Result<RigidSolver, String> {
+        let found = checkpoint::restart_point(dir, CHECKPOINT_PART)
+            .map_err(|e| e.to_string())?
+            .ok_or_else(|| format!("--restart {}: no structure checkpoint there", dir.display()))?;
+        let file = found.dir.join(format!("{CHECKPOINT_PART}.{}", checkpoint::EXTENSION));
+        let ck = Checkpoint::read_file(&file).map_err(|e| e.to_string())?;
+        let mut solver = Self::open(setup, out, Some(ck.time))?;
+        solver.restore(&ck).map_err(|e| format!("checkpoint `{}`: {e}", file.display()))?;
+        Ok(solver)
+    }
+
+    /// [`RigidSolver::new`]; with `resume_at` the probe file is continued from that time.
+    fn open(setup: Setup, out: OutputDir, resume_at: Option<f64>) -> Result<RigidSolver, String> {
         let Setup { body, scheme, dt, t_end, probes_every, .. } = setup;
         let mut state = Oscillators::new(body.dynamics.clone(), &body.u0, &body.v0);
         body.impose(0.0, &mut state.u, &mut state.v, Some(&mut state.a));
         let scheme = Staggered::new(scheme, body.u0.len());
-        let probes = ProbeWriter::structure(out.path(), &[body.probe.as_str()])
-            .map_err(|e| format!("cannot create the probe file: {e}"))?;
+        let probes = ProbeWriter::structure_from(out.path(), &[body.probe.as_str()], resume_at)
+            .map_err(|e| format!("cannot open the probe file: {e}"))?;
         Ok(RigidSolver {
             load: vec![0.0; body.dofs.len()],
             body,
@@ -202,12 +224,17 @@ impl RigidSolver {
 }
 
 impl Handler<StructureEndpoint> for RigidSolver {
+    /// Publishes the topology and the state; a restarted solver publishes the checkpoint's state
+    /// and writes no probe row (its file holds that one).
     fn init(&mut self, ep: &mut StructureEndpoint) -> Result<f64, Failure> {
-        let header = StepHeader { step: 0, time: 0.0, dt: 0.0, topology_version: 1, count: 0 };
+        let (step, t) = (self.steps, self.t);
+        let header = StepHeader { step, time: t, dt: 0.0, topology_version: 1, count: 0 };
         let elements = &self.body.elements;
         ep.publish_topology(header, elements.len(), |out| out.copy_from_slice(elements))?;
-        self.publish(ep, 0, 0.0, 0.0, false)?;
-        self.write_probe()?;
+        self.publish(ep, step, t, 0.0, false)?;
+        if step == 0 {
+            self.write_probe()?;
+        }
         Ok(self.dt_stable())
     }
 
@@ -255,25 +282,6 @@ impl Handler<StructureEndpoint> for RigidSolver {
 
     fn finish(&mut self, _ep: &mut StructureEndpoint) -> Result<(), Failure> {
         self.probes.flush().map_err(probe_failure)
-    }
-}
-
-impl RigidSolver {
-    /// Writes `checkpoints/<tag>/structure.ckpt`: `u`, `v`, `a` of the free DOFs, their names in
-    /// the metadata; flushes the probes first.
-    fn write_checkpoint(&mut self, tag: &str) -> Result<(), Failure> {
-        let fail = |e| io_failure("cannot write the checkpoint", e);
-        let mut ck = Checkpoint::new(self.steps, self.t);
-        let names: Vec<&str> = (0..self.body.dofs.len()).map(|i| self.body.dof_name(i)).collect();
-        ck.set_meta(&names).map_err(fail)?;
-        for (name, values) in [("u", &self.state.u), ("v", &self.state.v), ("a", &self.state.a)] {
-            ck.put(name, values.clone()).map_err(fail)?;
-        }
-        self.probes.flush().map_err(probe_failure)?;
-        let dir =
-            self.out.checkpoints().map_err(|e| io_failure("cannot create checkpoints/", e))?;
-        ck.write(&dir, tag, CHECKPOINT_PART).map_err(fail)?;
-        Ok(())
     }
 }
 
@@ -474,7 +482,12 @@ mod coupled_tests {
             let (run_id, case, out) = (run_id.clone(), case.clone(), dir.path().to_path_buf());
             std::thread::spawn(move || {
                 let mut solver = solver_in(&case, &out);
-                let info = HelloInfo { n_surface_nodes: 1, n_surface_elements: 0, case_hash: 0 };
+                let info = HelloInfo {
+                    n_surface_nodes: 1,
+                    n_surface_elements: 0,
+                    case_hash: 0,
+                    capabilities: 0,
+                };
                 let mut ep = StructureEndpoint::open(&run_id, info, Timeouts::default()).unwrap();
                 serve(&mut ep, &mut solver).unwrap();
             })

@@ -31,6 +31,40 @@ impl FeDynamics {
         FeDynamics { model, stepper: None, scheme, v0, zero }
     }
 
+    /// The integrator of a checkpoint's state (`state`, central differences' `v_half` when the
+    /// checkpoint holds it), as if START and the steps before it had run: the model holds the
+    /// checkpoint's configuration already (`restart::restore_state`).
+    pub fn resume(&mut self, state: crate::time::Dynamics, v_half: Option<&[f64]>) {
+        self.stepper = Some(match self.scheme {
+            Scheme::A6 => {
+                Stepper::Midpoint(Implicit::resume(&self.model, ImplicitScheme::Midpoint, state))
+            }
+            Scheme::Css | Scheme::C0 => {
+                let mut cd = CentralDifference::resume(&self.model, state);
+                if let Some(v) = v_half.filter(|v| v.len() == cd.v_half.len()) {
+                    cd.v_half.copy_from_slice(v);
+                }
+                Stepper::Explicit(cd)
+            }
+        });
+    }
+
+    /// Drops the midpoint rule's kept factor at a checkpoint, so that the next step starts as
+    /// a resumed integrator's does and a restart from there continues bitwise.
+    pub fn forget_factor(&mut self) {
+        if let Some(Stepper::Midpoint(im)) = self.stepper.as_mut() {
+            im.forget_factor();
+        }
+    }
+
+    /// Central differences' `v^{n+1/2}` of the last step (None for the midpoint rule).
+    pub fn v_half(&self) -> Option<&[f64]> {
+        match &self.stepper {
+            Some(Stepper::Explicit(cd)) => Some(&cd.v_half),
+            _ => None,
+        }
+    }
+
     /// The dynamic state (`t`, `v`, `a`) of the integrator, once started.
     pub fn state(&self) -> Option<&crate::time::Dynamics> {
         match &self.stepper {

@@ -19,10 +19,12 @@ use interface_protocol::case::{Case, Integrator, Scheme};
 use interface_protocol::coupling::{Dynamics, Staggered};
 use interface_protocol::endpoint::{StructureEndpoint, Timeouts};
 use interface_protocol::handshake::HelloInfo;
-use interface_protocol::io::checkpoint::Checkpoint;
+use interface_protocol::io::checkpoint::{self, Checkpoint};
 use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::ProbeWriter;
-use interface_protocol::messages::{scheme_phase, Command, NodeLoad, NodeState, StepHeader};
+use interface_protocol::messages::{
+    capability, scheme_phase, Command, NodeLoad, NodeState, StepHeader,
+};
 use interface_protocol::participant::{failure_code, serve, Failure, Handler, Progress};
 
 use interface_protocol::io::progress::Progress as Bar;
@@ -31,7 +33,7 @@ use crate::assembly::RotaryInertia;
 use crate::build::{build, field_error, need, section, Structure};
 use crate::model::Model;
 use crate::output::FieldOutput;
-use crate::restart::{save_dynamics, save_state, PART};
+use crate::restart::{load_dynamics, restore_state, save_dynamics, save_state, PART};
 use crate::state_check::{check_dofs, check_state};
 use crate::time::{critical_dt, StableStep};
 
@@ -157,8 +159,40 @@ pub fn unstable_coupling(
 }
 
 impl Participant {
-    /// The participant of `case` writing into `out`.
-    pub fn new(case: &Case, out: &Path, quiet: bool) -> anyhow::Result<Participant> {
+    /// The participant of `case` writing into `out`; with `restart`, continuing a coupled run
+    /// from the checkpoint it names (`checkpoint::restart_point`): model, integrator, the
+    /// scheme's history, step and time restored, `structure_probes.csv` kept up to the
+    /// checkpoint's time (`structure.xdmf` starts anew at it).
+    pub fn new(
+        case: &Case,
+        out: &Path,
+        quiet: bool,
+        restart: Option<&Path>,
+    ) -> anyhow::Result<Participant> {
+        let ck = match restart {
+            Some(dir) => {
+                let found = checkpoint::restart_point(dir, PART)?.ok_or_else(|| {
+                    anyhow!("--restart {}: no structure checkpoint there", dir.display())
+                })?;
+                let file = found.dir.join(format!("{PART}.{}", checkpoint::EXTENSION));
+                Some(Checkpoint::read_file(&file)?)
+            }
+            None => None,
+        };
+        let mut p = Self::fresh(case, out, quiet, ck.as_ref().map(|c| c.time))?;
+        if let Some(ck) = &ck {
+            p.restore(ck)?;
+        }
+        Ok(p)
+    }
+
+    /// The participant at the start; `resume_at`: the probe file is continued from that time.
+    fn fresh(
+        case: &Case,
+        out: &Path,
+        quiet: bool,
+        resume_at: Option<f64>,
+    ) -> anyhow::Result<Participant> {
         let s = section(case)?;
         let scheme = case.coupling.scheme;
         let Coupled { structure, wet, dt_stable, stable_rule } = prepare_coupled(case)?;
@@ -166,7 +200,7 @@ impl Participant {
         let dir = OutputDir::create(out, Policy::Existing)
             .or_else(|_| OutputDir::create(out, Policy::Overwrite))?;
         let names: Vec<&str> = s.probes.iter().map(|p| p.name.as_str()).collect();
-        let probes = ProbeWriter::structure(dir.path(), &names)?;
+        let probes = ProbeWriter::structure_from(dir.path(), &names, resume_at)?;
         let n = model.n_dof();
         let fields = FieldOutput::create(dir.path(), &mesh, Some(cells))?;
         Ok(Participant {
@@ -196,12 +230,30 @@ impl Participant {
         })
     }
 
+    /// Puts the checkpoint `ck` ([`Participant::write_checkpoint`]) back: the sequence goes on
+    /// with PREDICT of step `ck.step` as if never stopped. An error names the file and field.
+    fn restore(&mut self, ck: &Checkpoint) -> anyhow::Result<()> {
+        let d = &mut self.dynamics;
+        restore_state(&mut d.model, ck)?;
+        let state = load_dynamics(ck, d.model.n_dof())?;
+        d.resume(state, ck.f64("v_half").ok());
+        self.scheme
+            .restore(|name| ck.f64(&format!("coupling.{name}")).ok().map(<[f64]>::to_vec))
+            .map_err(|e| anyhow!("checkpoint at step {}: {e}", ck.step))?;
+        if let Some(rule) = self.stable_rule {
+            self.dt_stable = rule.at(&self.dynamics.model);
+        }
+        (self.steps, self.t) = (ck.step, ck.time);
+        Ok(())
+    }
+
     /// What the launcher's `Hello` check compares.
     pub fn hello(&self, case: &Case) -> HelloInfo {
         HelloInfo {
             n_surface_nodes: self.wet.nodes.len() as u64,
             n_surface_elements: self.wet.elements.len() as u64,
             case_hash: case.hash(),
+            capabilities: capability::RESTART,
         }
     }
 
@@ -397,14 +449,20 @@ impl Participant {
     }
 
     /// Writes `checkpoints/<tag>/structure.ckpt`: the model's state, velocities and
-    /// accelerations, and the scheme's own state (C0: `F^{n+1/2}`, `v^{n-1/2}`; A6: `â^n`).
-    fn write_checkpoint(&self, tag: &str) -> anyhow::Result<()> {
+    /// accelerations (central differences: and `v^{n+1/2}`), and the scheme's own state (C0:
+    /// `F^{n+1/2}`, `v^{n-1/2}`; A6: `â^n`). The midpoint rule's kept factor is dropped first,
+    /// as in a run alone, so that a restart continues bitwise.
+    fn write_checkpoint(&mut self, tag: &str) -> anyhow::Result<()> {
+        self.dynamics.forget_factor();
         let Some(d) = self.dynamics.state() else {
             bail!("a checkpoint needs START first");
         };
         let mut ck = Checkpoint::new(self.steps, self.t);
         save_state(&self.dynamics.model, &mut ck)?;
         save_dynamics(&mut ck, d)?;
+        if let Some(v) = self.dynamics.v_half() {
+            ck.put("v_half", v.to_vec())?;
+        }
         for (name, values) in self.scheme.history() {
             ck.put(&format!("coupling.{name}"), values)?;
         }
@@ -436,11 +494,15 @@ impl Handler<StructureEndpoint> for Participant {
         let elements = &self.wet.elements;
         ep.publish_topology(header, elements.len(), |out| out.copy_from_slice(elements))?;
         self.dynamics.displacement(&mut self.current);
-        self.publish(ep, (0, 0.0, 0.0), &self.current, self.dynamics.velocity())?;
-        self.write_probes()?;
+        // A restarted structure publishes the checkpoint's state; its probe file holds its row.
+        let (step, t) = (self.steps, self.t);
+        self.publish(ep, (step, t, 0.0), &self.current, self.dynamics.velocity())?;
+        if step == 0 {
+            self.write_probes()?;
+        }
         let d = &self.dynamics;
         if let Some(f) = self.fields.as_mut() {
-            f.gather(0.0, &d.model, Some(&d.model), d.velocity())
+            f.gather(t, &d.model, Some(&d.model), d.velocity())
                 .map_err(|e| Failure::new(failure_code::SOLVER, format!("initial state: {e}")))?;
         }
         self.write_fields()?;
@@ -482,12 +544,13 @@ pub fn run(
     out: Option<PathBuf>,
     set: &[String],
     quiet: bool,
+    restart: Option<&Path>,
 ) -> anyhow::Result<()> {
     let case = Case::load(case_path, set)?;
     let out = out
         .or_else(|| case.output.dir.as_ref().map(|d| case.dir().join(d)))
         .unwrap_or_else(|| PathBuf::from("runs").join(format!("{}-structure", case.case.name)));
-    let mut participant = Participant::new(&case, &out, quiet)?;
+    let mut participant = Participant::new(&case, &out, quiet, restart)?;
     let mut endpoint = StructureEndpoint::open(
         run_id,
         participant.hello(&case),

@@ -62,8 +62,12 @@ fn main() -> anyhow::Result<()> {
         r => anyhow::bail!("--role: expected fluid or structure, got {r}"),
     };
     let case = Case::load(&args.case, &args.overrides)?;
-    let info =
-        HelloInfo { n_surface_nodes: args.nodes, n_surface_elements: 0, case_hash: case.hash() };
+    let info = HelloInfo {
+        n_surface_nodes: args.nodes,
+        n_surface_elements: 0,
+        case_hash: case.hash(),
+        capabilities: 0,
+    };
     let fail = match (args.fail_init, args.fail) {
         (Some(message), _) => Some((When::parse("init", 0)?, message)),
         (None, Some(message)) => Some((When::parse(&args.fail_on, args.fail_step)?, message)),

@@ -221,7 +221,12 @@ fn run(args: &RunArgs) -> Result<(), String> {
         }
         return piston.probes.flush().map_err(|e| e.to_string());
     };
-    let info = HelloInfo { n_surface_nodes: 0, n_surface_elements: 0, case_hash: case.hash() };
+    let info = HelloInfo {
+        n_surface_nodes: 0,
+        n_surface_elements: 0,
+        case_hash: case.hash(),
+        capabilities: 0,
+    };
     let mut endpoint =
         FluidEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))
             .map_err(|e| format!("cannot join run {run_id}: {e}"))?;

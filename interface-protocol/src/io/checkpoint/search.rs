@@ -124,6 +124,22 @@ pub fn search(checkpoints_dir: &Path, parts: &[&str]) -> Result<Search, Checkpoi
     Ok(Search { found, skipped })
 }
 
+/// The checkpoint `--restart dir` names for `part`: `dir` itself when it is one checkpoint
+/// folder (it holds `<part>.ckpt`: what `fsi run --restart` passes each participant, the newest
+/// checkpoint every part of the run wrote), else the newest complete one under
+/// `dir/checkpoints` ([`latest`]); `None` if there is none. A named folder whose part is
+/// damaged is an error, not passed over.
+pub fn restart_point(dir: &Path, part: &str) -> Result<Option<Found>, CheckpointError> {
+    check_tag(part)?;
+    let file = part_path(dir, part);
+    if !file.is_file() {
+        return latest(&dir.join("checkpoints"), &[part]);
+    }
+    let ck = Checkpoint::read_file(&file)?;
+    let tag = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    Ok(Some(Found { tag, dir: dir.to_path_buf(), step: ck.step, time: ck.time }))
+}
+
 /// Why `part` cannot be used, without the path (the notice names the folder).
 fn why(part: &str, e: &CheckpointError) -> String {
     let file = format!("{part}.{EXTENSION}");
@@ -153,6 +169,22 @@ mod tests {
     use super::super::tag_for_step;
     use super::super::tests::{overwrite, sample};
     use super::*;
+
+    #[test]
+    fn a_restart_names_a_run_folder_or_one_checkpoint_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let ck = dir.path().join("checkpoints");
+        assert_eq!(restart_point(dir.path(), "fluid").unwrap(), None);
+        for step in [10, 20] {
+            sample(step).write(&ck, &tag_for_step(step), "fluid").unwrap();
+        }
+        assert_eq!(restart_point(dir.path(), "fluid").unwrap().unwrap().step, 20);
+        let one = restart_point(&ck.join(tag_for_step(10)), "fluid").unwrap().unwrap();
+        assert_eq!((one.tag.as_str(), one.step), ("step_0000000010", 10));
+        assert_eq!(one.dir, ck.join(tag_for_step(10)));
+        // A named folder without the part is a run folder without checkpoints.
+        assert_eq!(restart_point(&ck.join(tag_for_step(10)), "structure").unwrap(), None);
+    }
 
     #[test]
     fn latest_skips_incomplete_and_damaged_folders() {
