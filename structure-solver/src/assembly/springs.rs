@@ -26,7 +26,9 @@ pub struct NodeSpring {
 pub enum SpringError {
     #[error("spring: node {node} out of range ({n} nodes)")]
     NodeRange { node: usize, n: usize },
-    #[error("spring: node {node} is a slave of a rigid body; put the spring on its reference node")]
+    #[error(
+        "spring: node {node} is a slave of a rigid body; put the spring on its reference node"
+    )]
     Slave { node: usize },
     #[error("spring: the stiffness must be finite and >= 0 and the preload finite, got stiffness {stiffness:?}, preload {preload:?}")]
     Bad { stiffness: [f64; 3], preload: [f64; 3] },
