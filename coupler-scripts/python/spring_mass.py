@@ -98,7 +98,7 @@ class Body:
                     fail(f + key, f"expected one number or {n} (one per entry of `dofs`), "
                                   f"got {len(v)}")
                 return [number({"v": x}, "v", f"{f}{key}[{i}]") for i, x in enumerate(v)]
-            return [number(rigid, key, f + key)] * n
+            return [number(rigid, key, f + key, 0.0)] * n
 
         self.k, self.c = per_dof("stiffness"), per_dof("damping")
         if any(x < 0 for x in self.k + self.c):

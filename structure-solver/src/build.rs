@@ -1,7 +1,8 @@
 //! The structure of a case, ready to integrate: the `[structure]` section (DESIGN §7; the
 //! schema is documented in `interface_protocol::case::structure`) made into one
 //! `assembly::FeModel`: the mesh and its sets ([`crate::case_mesh`]), the element part of each
-//! cell, boundary conditions, loads with time curves, rigid bodies and the initial velocity.
+//! cell, boundary conditions, loads with time curves, rigid bodies (and their springs) and the
+//! initial velocity.
 //! Errors name the case file and the field.
 
 use anyhow::anyhow;
@@ -10,7 +11,7 @@ use interface_protocol::case::{
     StructureMaterial, StructureSection, Symmetry,
 };
 
-use crate::assembly::{Curve, FeModel, Part, RotaryInertia};
+use crate::assembly::{Curve, FeModel, NodeSpring, Part, RotaryInertia};
 use crate::case_mesh::build_mesh;
 use crate::elements::{BeamSection, BeamYield, ShellSection, ShellYield};
 use crate::material::{Elastic, Material, J2};
@@ -383,6 +384,10 @@ pub fn build(case: &Case, rotary: RotaryInertia) -> anyhow::Result<Structure> {
             mesh.push_node([p.x, p.y, p.z]);
             mesh.node_sets.get_mut("all").expect("built with the mesh").push(master);
             body_of.push(None);
+        }
+        if let Some(sp) = &rb.spring {
+            let spring = NodeSpring { node: master, stiffness: sp.stiffness, preload: sp.preload };
+            fe.add_spring(spring).map_err(|e| field_error(case, &format!("{f}.spring"), e))?;
         }
         mesh.node_sets.insert(format!("{}_reference", rb.set), vec![master]);
         nodes.iter().filter(|&&n| n != master).for_each(|&n| body_of[n] = Some(k));

@@ -33,6 +33,16 @@ pub fn bin(name: &str) -> PathBuf {
     p
 }
 
+/// `structure.command=[".../spring-mass"]` (for `--set`) with the absolute path of the Python
+/// structure's wrapper, `coupler-scripts/python/spring-mass` (its venv: `install.sh` there).
+pub fn python_structure() -> String {
+    let wrapper = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../coupler-scripts/python/spring-mass")
+        .canonicalize()
+        .expect("coupler-scripts/python/spring-mass exists");
+    format!("structure.command=[\"{}\"]", wrapper.display())
+}
+
 /// A run id no other test or process uses: `t<pid>-<tag>-<counter>`.
 pub fn unique_run_id(tag: &str) -> String {
     static NEXT: AtomicU32 = AtomicU32::new(0);

@@ -5,22 +5,15 @@
 //!
 //! Needs the venv of `coupler-scripts/python/install.sh` (`scripts/install-deps.sh` runs it).
 
-use fsi_system_tests::{alive, run_files, signal, Fsi, Oscillator, Probes, Scratch};
+use fsi_system_tests::{
+    alive, python_structure, run_files, signal, Fsi, Oscillator, Probes, Scratch,
+};
 use interface_protocol::case::Case;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 fn spring_piston() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/spring-piston/case.toml")
-}
-
-/// `--set structure.command=[".../spring-mass"]` with the wrapper's absolute path.
-fn python_structure() -> String {
-    let wrapper = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../coupler-scripts/python/spring-mass")
-        .canonicalize()
-        .expect("coupler-scripts/python/spring-mass exists");
-    format!("structure.command=[\"{}\"]", wrapper.display())
 }
 
 /// Runs the spring-piston case with `scheme`, the Python structure if `python`, into `out`.

@@ -114,13 +114,19 @@
 //! # mass = 1.0                      # mass added at the reference node
 //! # inertia = [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.2]]  # rotary inertia added
 //! #                                 # about the reference node (global axes, symmetric)
+//! # spring = { stiffness = [1400.0, 0.0, 0.0], preload = [-1000.0, 0.0, 0.0] }
+//! #   a linear spring on the reference node's translations, in the global axes: the force
+//! #   on it is `preload - stiffness · u` per axis (`u` its displacement from the start; N/m,
+//! #   N), part of the internal force and the tangent, its `2 sqrt(m/k)` in the stable step
 //! ```
 
 use std::collections::BTreeMap;
 
 use super::RigidBody;
 
+mod rigid_part;
 mod validate;
+pub use rigid_part::{RigidPart, RigidSpring};
 use serde::Deserialize;
 
 /// `[structure]`.
@@ -590,24 +596,6 @@ pub struct NodalValue {
 pub struct StructureProbe {
     pub name: String,
     pub point: [f64; 3],
-}
-
-/// `[[structure.rigid_bodies]]`: the nodes of `set` move as one rigid body with a new
-/// reference node at `reference` (default their mass centre), or the existing node of the
-/// one-node set `reference_set`, which carries `mass` and the rotary inertia `inertia`
-/// (about it, global axes) more.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RigidPart {
-    pub set: String,
-    #[serde(default)]
-    pub reference: Option<[f64; 3]>,
-    #[serde(default)]
-    pub reference_set: Option<String>,
-    #[serde(default)]
-    pub mass: f64,
-    #[serde(default)]
-    pub inertia: Option<[[f64; 3]; 3]>,
 }
 
 impl StructureSection {

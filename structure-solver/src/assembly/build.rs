@@ -112,6 +112,7 @@ impl FeModel {
             constrained,
             user_fixed: vec![false; 6 * nn],
             rigid: vec![],
+            springs: vec![],
             skew: vec![],
             skew_of: vec![None; nn],
             body_of: vec![None; nn],

@@ -68,6 +68,7 @@ impl Model for FeModel {
     fn internal_force(&mut self, f: &mut [f64]) {
         f.fill(0.0);
         self.element_forces(f);
+        self.spring_forces(f);
         if let Some(b) = &mut self.explicit {
             b.internal_force(&self.trial, &self.committed, f);
         }
@@ -114,6 +115,7 @@ impl Model for FeModel {
     /// Tangent of internal minus external force, reduced by the rigid bodies.
     fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
         self.element_tangent(t, out);
+        self.spring_tangent(out);
         if !self.rigid.is_empty() {
             self.reduce_tangent(t, out);
         }

@@ -2,7 +2,8 @@
 //!
 //! Files by job: `build` (mesh cells to elements, lumped mass), `constraints` (fixed,
 //! prescribed and skew-symmetry dofs and their reduction), `rigid_bodies` (rigid bodies and
-//! links: slaves on masters, the reduction `Tᵀ f`, `Tᵀ K T`), `loads` (time curves, point
+//! links: slaves on masters, the reduction `Tᵀ f`, `Tᵀ K T`), `springs` (linear springs on a
+//! node's translations with a preload: a rigid body's spring), `loads` (time curves, point
 //! loads, pressure, gravity, the coupling's nodal array), `forces` (the `Model` the
 //! integrators call; `element_forces` its element loop, `explicit_shells` the BT4 and BLT3
 //! shells), `stable_step` (the element bound of the critical step at the current
@@ -39,6 +40,7 @@ mod explicit_shells;
 mod forces;
 mod loads;
 mod rigid_bodies;
+mod springs;
 mod stable_step;
 mod state;
 mod topology;
@@ -58,6 +60,7 @@ use crate::rigid::RigidBody;
 use constraints::SkewNode;
 use explicit_shells::ExplicitShells;
 pub use loads::Curve;
+pub use springs::{NodeSpring, SpringError};
 pub use topology::{IdMap, Store, Topology, TopologyError};
 pub use topology_change::NewNode;
 pub use topology_record::TopologyRecord;
@@ -142,6 +145,8 @@ pub struct FeModel {
     /// or are rigid slaves).
     user_fixed: Vec<bool>,
     rigid: Vec<RigidBody>,
+    /// Linear springs on nodes (`springs`).
+    springs: Vec<springs::NodeSpring>,
     /// Nodes on skew symmetry planes, and the entry of each node in it.
     skew: Vec<SkewNode>,
     skew_of: Vec<Option<usize>>,

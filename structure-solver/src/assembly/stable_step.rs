@@ -4,7 +4,8 @@
 //! reference configuration; every step it is scaled by how the element's characteristic
 //! length changed, `ρ = L(x)/L(X)`: by `ρ` for tets (a wave speed over a length), by
 //! `min(ρ, ρ²)` for shells and beams (their bending frequencies go as `1/L²`), so a shrinking
-//! element shortens the step. The explicit shells give their own (`ExplicitShells::stable_dt`).
+//! element shortens the step. The explicit shells give their own (`ExplicitShells::stable_dt`),
+//! the springs theirs (`springs`: `2/ω` with the mass of the node they hold).
 
 use nalgebra::Vector3;
 
@@ -67,6 +68,6 @@ impl FeModel {
         if let Some(b) = &self.explicit {
             dt = dt.min(b.stable_dt());
         }
-        dt
+        dt.min(self.spring_stable_dt())
     }
 }

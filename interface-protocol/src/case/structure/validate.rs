@@ -256,6 +256,9 @@ impl StructureSection {
                         .into(),
                 ));
             }
+            if let Some(spring) = &r.spring {
+                spring.validate(&format!("{f}.spring"))?;
+            }
             if let Some(j) = &r.inertia {
                 for (i, row) in j.iter().enumerate() {
                     finite(&format!("{f}.inertia[{i}]"), row)?;
