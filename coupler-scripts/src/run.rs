@@ -95,6 +95,29 @@ struct LauncherReport<'a> {
     dt: f64,
     t_end: f64,
     overrides: &'a [String],
+    coupling_overhead: Overhead,
+}
+
+/// The launcher's cost: the stepping wall time (from the end of start-up to the exits) that
+/// neither participant reports as work. The staggered schemes run the two solvers one after the
+/// other, so that wall time is their work plus this overhead (sequencing, IPC latency, wake-ups).
+#[derive(Debug, Serialize)]
+struct Overhead {
+    /// Wall seconds after start-up (processes started, `Hello` exchanged).
+    stepping_seconds: f64,
+    /// Of those, the seconds in neither participant's reported work.
+    seconds: f64,
+    /// `seconds / stepping_seconds` (0 for a run that never stepped).
+    fraction: f64,
+}
+
+impl Overhead {
+    fn of(stepping: f64, solver: &BTreeMap<&'static str, SolverTime>) -> Overhead {
+        let work: f64 = solver.values().map(|t| t.work_s).sum();
+        let seconds = (stepping - work).max(0.0);
+        let fraction = if stepping > 0.0 { seconds / stepping } else { 0.0 };
+        Overhead { stepping_seconds: stepping, seconds, fraction }
+    }
 }
 
 /// A fresh run id: `r<pid>-<nanoseconds>` in hex (unique per process and instant).
@@ -501,7 +524,9 @@ fn write_report(
         timings,
         surface: None,
     };
+    let stepping = wall.saturating_sub(launcher[0].1).as_secs_f64();
     let full = LauncherReport {
+        coupling_overhead: Overhead::of(stepping, solver),
         report: &report,
         run_id,
         scheme: scheme_name(case.coupling.scheme).to_string(),
@@ -518,6 +543,19 @@ fn write_report(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_overhead_is_the_stepping_time_neither_solver_worked() {
+        let solver = BTreeMap::from([
+            ("fluid", SolverTime { work_s: 6.0, wait_s: 3.5 }),
+            ("structure", SolverTime { work_s: 3.0, wait_s: 6.5 }),
+        ]);
+        let o = Overhead::of(10.0, &solver);
+        assert_eq!((o.seconds, o.fraction), (1.0, 0.1));
+        // Clock skew between the processes never makes it negative; no stepping, no fraction.
+        assert_eq!(Overhead::of(8.0, &solver).seconds, 0.0);
+        assert_eq!(Overhead::of(0.0, &BTreeMap::new()).fraction, 0.0);
+    }
 
     #[test]
     fn generated_run_ids_are_valid_and_distinct() {

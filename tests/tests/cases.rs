@@ -26,5 +26,25 @@ fn spring_piston_follows_the_damped_oscillation() {
     // The radiation damping A ρ0 c0 alone takes the amplitude down by e^2 over the run: a load
     // without it, or with the wrong sign, is off by O(1).
     assert!(e < 2e-2, "relative error {e}");
-    assert!(out.join("run.json").is_file());
+    check_overhead(&out.join("run.json"));
+}
+
+/// `run.json`'s `coupling_overhead` is the stepping wall time less both participants' work.
+fn check_overhead(run_json: &Path) {
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_json).expect("run.json")).unwrap();
+    let o = &r["coupling_overhead"];
+    let (stepping, seconds, fraction) = (
+        o["stepping_seconds"].as_f64().expect("stepping_seconds"),
+        o["seconds"].as_f64().expect("seconds"),
+        o["fraction"].as_f64().expect("fraction"),
+    );
+    let work: f64 = ["fluid", "structure"]
+        .iter()
+        .map(|p| r["timings"][p]["work"].as_f64().expect("work seconds of each participant"))
+        .sum();
+    println!("coupling overhead: {seconds:.4} s of {stepping:.4} s stepping ({fraction:.4})");
+    assert!(stepping > 0.0 && stepping <= r["wall_seconds"].as_f64().unwrap());
+    assert!((seconds - (stepping - work).max(0.0)).abs() < 1e-9 && seconds <= stepping);
+    assert!((fraction - seconds / stepping).abs() < 1e-12, "{o}");
 }
