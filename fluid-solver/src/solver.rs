@@ -27,7 +27,7 @@ use crate::state::{State, Workspace};
 use crate::time::{reached, rk2_step, FixedSteps, TimeStepping};
 use anyhow::Context;
 use interface_protocol::case::Case;
-use interface_protocol::io::checkpoint::{self, Checkpoint, Found};
+use interface_protocol::io::checkpoint;
 use interface_protocol::io::finite::{check_finite, Entity};
 use interface_protocol::io::outdir::{OutputDir, Policy};
 use interface_protocol::io::probes::{write_line_sample, ProbeWriter};
@@ -37,8 +37,9 @@ use interface_protocol::io::xdmf::TimeSeriesWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Checkpoint part name of the fluid.
-pub const CHECKPOINT_PART: &str = "fluid";
+mod checkpoint_part;
+use checkpoint_part::read_fluid_part;
+pub use checkpoint_part::{read_checkpoint, CHECKPOINT_PART};
 
 /// Command-line options of `fluid-solver run`.
 #[derive(Debug, Clone, Default)]
@@ -57,42 +58,6 @@ pub struct RunSummary {
     pub steps: u64,
     pub time: f64,
     pub nodes: usize,
-}
-
-/// Reads the conserved state, node materials and level set of the checkpoint `--restart
-/// run_dir` names: the newest complete one under `run_dir/checkpoints`, or `run_dir` itself
-/// when it is one checkpoint folder ([`checkpoint::restart_point`]). A checkpoint without
-/// `material` is of one fluid, material 0; one without `phi` has no level set.
-pub fn read_checkpoint(run_dir: &Path, n_nodes: usize) -> anyhow::Result<(State, u64, f64)> {
-    let found = checkpoint::restart_point(run_dir, CHECKPOINT_PART)?.with_context(|| {
-        format!("no complete fluid checkpoint in {}", run_dir.join("checkpoints").display())
-    })?;
-    read_fluid_part(&found, n_nodes)
-}
-
-/// The fluid part of the checkpoint `found` ([`read_checkpoint`]).
-fn read_fluid_part(found: &Found, n_nodes: usize) -> anyhow::Result<(State, u64, f64)> {
-    let part = format!("{CHECKPOINT_PART}.{}", checkpoint::EXTENSION);
-    let ck = Checkpoint::read_file(&found.dir.join(part))?;
-    let cons = ck.f64_n::<5>("cons")?;
-    let material = match ck.names().any(|n| n == "material") {
-        true => ck.u8("material")?.to_vec(),
-        false => vec![0; cons.len()],
-    };
-    let phi = match ck.names().any(|n| n == "phi") {
-        true => ck.f64("phi")?.to_vec(),
-        false => Vec::new(),
-    };
-    anyhow::ensure!(
-        cons.len() == n_nodes && material.len() == n_nodes && phi.len() % n_nodes.max(1) == 0,
-        "checkpoint {} holds {} nodes ({} material ids, {} level-set values), but the case's mesh \
-         has {n_nodes}",
-        found.dir.display(),
-        cons.len(),
-        material.len(),
-        phi.len()
-    );
-    Ok((State { cons, material, phi }, ck.step, ck.time))
 }
 
 pub use crate::setup::Mode;
@@ -519,25 +484,6 @@ impl<'a> FluidRun<'a> {
     /// Whether a step failed (the run can then only finish).
     pub fn failed(&self) -> bool {
         self.status.is_err()
-    }
-
-    /// Writes the conserved state, node materials and level set as the checkpoint `tag` (part
-    /// [`CHECKPOINT_PART`]), after the embedded surface's part if there is one (so a fluid part
-    /// always has its embedded part beside it).
-    pub fn write_checkpoint(&mut self, tag: &str) -> anyhow::Result<()> {
-        let start = Instant::now();
-        if let Some(e) = &self.embedded {
-            embedded::checkpoint::write(e, &self.out.checkpoints()?, tag, self.step, self.t)?;
-        }
-        let mut ck = Checkpoint::new(self.step, self.t);
-        ck.put_f64_n("cons", &self.state.cons)?;
-        ck.put("material", self.state.material.clone())?;
-        if !self.state.phi.is_empty() {
-            ck.put("phi", self.state.phi.clone())?;
-        }
-        ck.write(&self.out.checkpoints()?, tag, CHECKPOINT_PART)?;
-        self.timers.add_since(bucket::OUTPUT, start);
-        Ok(())
     }
 
     /// Writes the final fields and lines (and, alone, the final checkpoint and `run.json`) and
