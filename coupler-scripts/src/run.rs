@@ -237,8 +237,10 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
     };
     let launcher = [("startup", session.startup), ("ipc_wait", session.ipc_wait)];
     let solver = session.solver.clone();
+    let startup = session.startup;
     drop(session);
     let wall = start.elapsed();
+    let overhead = Overhead::of(wall.saturating_sub(startup).as_secs_f64(), &solver);
     let status = match (&result, &cleaned) {
         (Err(e @ RunError::Interrupted(_)), _) => format!("interrupted: {e}"),
         (Err(e), _) => format!("failed: {e}"),
@@ -253,7 +255,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         &run_id,
         &status,
         (steps, final_time),
-        (wall, launcher, &solver),
+        Timings { wall, launcher, solver: &solver, coupling_overhead: overhead },
     );
     bar.finish();
     result?;
@@ -484,6 +486,15 @@ impl Session<'_> {
     }
 }
 
+/// The run's clocks as `run.json` reports them.
+struct Timings<'a> {
+    wall: Duration,
+    /// The launcher's own buckets (start-up, IPC wait).
+    launcher: [(&'static str, Duration); 2],
+    solver: &'a BTreeMap<&'static str, SolverTime>,
+    coupling_overhead: Overhead,
+}
+
 /// Writes `run.json`: the common report plus the launcher's view (run id, scheme, overrides).
 fn write_report(
     out: &OutputDir,
@@ -492,11 +503,7 @@ fn write_report(
     run_id: &str,
     status: &str,
     (steps, final_time): (u64, f64),
-    (wall, launcher, solver): (
-        Duration,
-        [(&str, Duration); 2],
-        &BTreeMap<&'static str, SolverTime>,
-    ),
+    Timings { wall, launcher, solver, coupling_overhead }: Timings,
 ) -> std::io::Result<()> {
     let text = std::fs::read_to_string(&opts.case_file).unwrap_or_default();
     let mut versions = report::versions();
@@ -524,9 +531,8 @@ fn write_report(
         timings,
         surface: None,
     };
-    let stepping = wall.saturating_sub(launcher[0].1).as_secs_f64();
     let full = LauncherReport {
-        coupling_overhead: Overhead::of(stepping, solver),
+        coupling_overhead,
         report: &report,
         run_id,
         scheme: scheme_name(case.coupling.scheme).to_string(),
