@@ -80,7 +80,7 @@ class Reply(ctypes.Structure):
         ("work_s", ctypes.c_double),
         ("wait_s", ctypes.c_double),
         ("message", ctypes.c_uint8 * 256),
-        ("reserved", ctypes.c_uint64),
+        ("interface_work", ctypes.c_double),
     ]
 
     @staticmethod

@@ -17,7 +17,7 @@ use interface_protocol::io::outdir::{default_run_dir, OutputDir, Policy};
 use interface_protocol::io::progress::Progress as Bar;
 use interface_protocol::io::report::{self, case_echo, RunReport};
 use interface_protocol::liveness;
-use interface_protocol::messages::{Command, Hello, Reply, Role};
+use interface_protocol::messages::{capability, Command, Hello, Reply, Role};
 use interface_protocol::shm;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -78,11 +78,23 @@ impl RunError {
     }
 }
 
-/// Per-participant totals of the `Done` replies.
-#[derive(Debug, Clone, Copy, Default, Serialize)]
+/// Per-participant totals of the `Done` replies, and the `(t, interface_work)` of the last two
+/// from a participant that announces [`capability::INTERFACE_WORK`] (`None` otherwise).
+#[derive(Debug, Clone, Copy, Default)]
 struct SolverTime {
     work_s: f64,
     wait_s: f64,
+    interface_work: Option<[(f64, f64); 2]>,
+}
+
+impl SolverTime {
+    /// The participant's interface work at `t`, linear through its last two samples: the
+    /// staggered schemes leave the fluid half a step from the structure (C0 ahead, A6 behind),
+    /// and the line through the last two brings both to one time within O(Δt²).
+    fn interface_work_at(&self, t: f64) -> Option<f64> {
+        let [(ta, wa), (tb, wb)] = self.interface_work?;
+        Some(if tb > ta { wb + (t - tb) / (tb - ta) * (wb - wa) } else { wb })
+    }
 }
 
 /// What `run.json` holds beyond the common report.
@@ -96,6 +108,34 @@ struct LauncherReport<'a> {
     t_end: f64,
     overrides: &'a [String],
     coupling_overhead: Overhead,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    interface_energy: Option<InterfaceEnergy>,
+}
+
+/// The energy ledger of the interface (PROTOCOL.md §3, `interface_work`): the work the fluid's
+/// loads did along the surface motion it was given, the work the structure's applied loads did
+/// along its own displacement, both from t = 0 to the last reply, and their difference, the
+/// energy the staggered scheme created at the interface (zero for an exact coupling).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+struct InterfaceEnergy {
+    fluid_work: f64,
+    structure_work: f64,
+    /// `fluid_work - structure_work` (J).
+    error: f64,
+    /// `error / max(|fluid_work|, |structure_work|)` (0 when both are 0).
+    relative: f64,
+}
+
+impl InterfaceEnergy {
+    /// The ledger at the run's end time `t` when both participants keep it.
+    fn of(solver: &BTreeMap<&'static str, SolverTime>, t: f64) -> Option<InterfaceEnergy> {
+        let work = |role: Role| solver.get(role.name()).and_then(|s| s.interface_work_at(t));
+        let (fluid_work, structure_work) = (work(Role::Fluid)?, work(Role::Structure)?);
+        let error = fluid_work - structure_work;
+        let scale = fluid_work.abs().max(structure_work.abs());
+        let relative = if scale > 0.0 { error / scale } else { 0.0 };
+        Some(InterfaceEnergy { fluid_work, structure_work, error, relative })
+    }
 }
 
 /// The launcher's cost: the stepping wall time (from the end of start-up to the exits) that
@@ -255,7 +295,13 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary, RunError> {
         &run_id,
         &status,
         (steps, final_time),
-        Timings { wall, launcher, solver: &solver, coupling_overhead: overhead },
+        Measured {
+            wall,
+            launcher,
+            solver: &solver,
+            coupling_overhead: overhead,
+            interface_energy: InterfaceEnergy::of(&solver, final_time),
+        },
     );
     bar.finish();
     result?;
@@ -282,6 +328,11 @@ impl Session<'_> {
         let structure = self.hello(Role::Structure, deadline)?;
         let fluid = self.hello(Role::Fluid, deadline)?;
         LauncherLink::check(&fluid, &structure, case_hash)?;
+        for (role, hello) in [(Role::Fluid, &fluid), (Role::Structure, &structure)] {
+            let keeps = hello.capabilities & capability::INTERFACE_WORK != 0;
+            self.solver.entry(role.name()).or_default().interface_work =
+                keeps.then_some([(0.0, 0.0); 2]);
+        }
         if self.restart {
             let label = |role| self.children.get(role).map_or(role.name().into(), |p| p.label());
             let labels = [label(Role::Fluid), label(Role::Structure)];
@@ -363,6 +414,12 @@ impl Session<'_> {
         let t = self.solver.entry(role.name()).or_default();
         t.work_s += reply.work_s.max(0.0);
         t.wait_s += reply.wait_s.max(0.0);
+        if let Some([older, last]) = &mut t.interface_work {
+            if reply.t > last.0 {
+                *older = *last;
+            }
+            *last = (reply.t, reply.interface_work);
+        }
     }
 
     /// After `Finish`: every child exits, with code 0, within `coupling.timeout_s`.
@@ -486,13 +543,14 @@ impl Session<'_> {
     }
 }
 
-/// The run's clocks as `run.json` reports them.
-struct Timings<'a> {
+/// The run's clocks and energy ledger as `run.json` reports them.
+struct Measured<'a> {
     wall: Duration,
     /// The launcher's own buckets (start-up, IPC wait).
     launcher: [(&'static str, Duration); 2],
     solver: &'a BTreeMap<&'static str, SolverTime>,
     coupling_overhead: Overhead,
+    interface_energy: Option<InterfaceEnergy>,
 }
 
 /// Writes `run.json`: the common report plus the launcher's view (run id, scheme, overrides).
@@ -503,7 +561,7 @@ fn write_report(
     run_id: &str,
     status: &str,
     (steps, final_time): (u64, f64),
-    Timings { wall, launcher, solver, coupling_overhead }: Timings,
+    Measured { wall, launcher, solver, coupling_overhead, interface_energy }: Measured,
 ) -> std::io::Result<()> {
     let text = std::fs::read_to_string(&opts.case_file).unwrap_or_default();
     let mut versions = report::versions();
@@ -533,6 +591,7 @@ fn write_report(
     };
     let full = LauncherReport {
         coupling_overhead,
+        interface_energy,
         report: &report,
         run_id,
         scheme: scheme_name(case.coupling.scheme).to_string(),
@@ -553,14 +612,29 @@ mod tests {
     #[test]
     fn the_overhead_is_the_stepping_time_neither_solver_worked() {
         let solver = BTreeMap::from([
-            ("fluid", SolverTime { work_s: 6.0, wait_s: 3.5 }),
-            ("structure", SolverTime { work_s: 3.0, wait_s: 6.5 }),
+            ("fluid", SolverTime { work_s: 6.0, wait_s: 3.5, interface_work: None }),
+            ("structure", SolverTime { work_s: 3.0, wait_s: 6.5, interface_work: None }),
         ]);
         let o = Overhead::of(10.0, &solver);
         assert_eq!((o.seconds, o.fraction), (1.0, 0.1));
         // Clock skew between the processes never makes it negative; no stepping, no fraction.
         assert_eq!(Overhead::of(8.0, &solver).seconds, 0.0);
         assert_eq!(Overhead::of(0.0, &BTreeMap::new()).fraction, 0.0);
+    }
+
+    #[test]
+    fn the_interface_energy_needs_both_ledgers() {
+        let with = |f: Option<[(f64, f64); 2]>, s: Option<[(f64, f64); 2]>| {
+            let t = |w| SolverTime { work_s: 1.0, wait_s: 0.0, interface_work: w };
+            InterfaceEnergy::of(&BTreeMap::from([("fluid", t(f)), ("structure", t(s))]), 1.0)
+        };
+        // The fluid half a step ahead (samples at 0.75 and 1.25) is read at 1.0 on its line.
+        let e = with(Some([(0.75, 1.0), (1.25, 3.0)]), Some([(0.5, 0.0), (1.0, 1.5)])).unwrap();
+        assert_eq!((e.fluid_work, e.structure_work), (2.0, 1.5));
+        assert_eq!((e.error, e.relative), (0.5, 0.25));
+        let at_rest = Some([(0.0, 0.0); 2]);
+        assert_eq!(with(at_rest, at_rest).unwrap().relative, 0.0);
+        assert!(with(at_rest, None).is_none() && with(None, at_rest).is_none());
     }
 
     #[test]

@@ -255,7 +255,8 @@ impl Handler<FluidEndpoint> for CoupledFluid<'_> {
             count: 0,
         };
         publish_loads(ep, run, header, self.n_nodes)?;
-        Ok(Progress { step: c.step, t: c.t_to, dt_stable: f64::INFINITY })
+        let interface_work = run.embedded().map_or(0.0, |e| e.interface_work);
+        Ok(Progress { step: c.step, t: c.t_to, dt_stable: f64::INFINITY, interface_work })
     }
 
     fn checkpoint(&mut self, _ep: &mut FluidEndpoint, tag: &str) -> Result<(), Failure> {
@@ -279,7 +280,7 @@ pub fn run(case: &Case, case_text: &str, opts: RunOptions, run_id: &str) -> anyh
         n_surface_nodes: 0,
         n_surface_elements: 0,
         case_hash: case.hash(),
-        capabilities: capability::RESTART,
+        capabilities: capability::RESTART | capability::INTERFACE_WORK,
     };
     let mut endpoint =
         FluidEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))

@@ -73,6 +73,9 @@ pub mod capability {
     /// The participant continues a run from a checkpoint (`run --restart DIR`, the restart
     /// sequence of PROTOCOL.md §4): a launcher refuses a restart with a participant without it.
     pub const RESTART: u64 = 1;
+    /// The participant reports `Reply::interface_work`: the launcher keeps the energy ledger
+    /// of the interface (`run.json`'s `interface_energy`) when both do.
+    pub const INTERFACE_WORK: u64 = 2;
 }
 
 /// Kinds of `Command::kind`.
@@ -130,7 +133,7 @@ pub mod reply_kind {
 /// Participant -> launcher response to a `Command`.
 ///
 /// Layout (312 bytes, align 8): `0:u32 kind, 4:u32 code, 8:u64 step, 16:f64 t, 24:f64 dt_stable,
-/// 32:f64 work_s, 40:f64 wait_s, 48:[u8;256] message (NUL-padded UTF-8), 304:u64 reserved`.
+/// 32:f64 work_s, 40:f64 wait_s, 48:[u8;256] message (NUL-padded UTF-8), 304:f64 interface_work`.
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[type_name("fsi::Reply::v1")]
 #[repr(C)]
@@ -146,7 +149,11 @@ pub struct Reply {
     pub work_s: f64,
     pub wait_s: f64,
     pub message: [u8; 256],
-    pub reserved: u64,
+    /// The work the interface loads did on the wet surface from the start of the run to `t`
+    /// (joules; cumulative, so a restart continues it), along the participant's own motion of
+    /// the surface: the fluid's along its Hermite path, the structure's along its displacement.
+    /// Read only from a participant that announces [`capability::INTERFACE_WORK`].
+    pub interface_work: f64,
 }
 
 impl Default for Reply {
@@ -160,7 +167,7 @@ impl Default for Reply {
             work_s: 0.0,
             wait_s: 0.0,
             message: [0; 256],
-            reserved: 0,
+            interface_work: 0.0,
         }
     }
 }

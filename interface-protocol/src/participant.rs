@@ -27,6 +27,18 @@ pub struct Progress {
     pub t: f64,
     /// Largest stable step from here (`f64::INFINITY` if unlimited).
     pub dt_stable: f64,
+    /// `Reply::interface_work` at `t` (0 from a participant that does not keep it).
+    pub interface_work: f64,
+}
+
+impl Progress {
+    /// The `Done` reply that reports it (the seconds are filled in by [`serve`]).
+    fn reply(&self) -> Reply {
+        Reply {
+            interface_work: self.interface_work,
+            ..Reply::done(self.step, self.t, self.dt_stable, 0.0, 0.0)
+        }
+    }
 }
 
 /// Why a command failed: sent to the launcher as `Failed { code, message }`.
@@ -71,7 +83,7 @@ pub fn serve<E: ControlPort, H: Handler<E>>(
     endpoint: &mut E,
     handler: &mut H,
 ) -> Result<(), ProtocolError> {
-    let mut last = Progress { step: 0, t: 0.0, dt_stable: f64::INFINITY };
+    let mut last = Progress { step: 0, t: 0.0, dt_stable: f64::INFINITY, interface_work: 0.0 };
     loop {
         let command = endpoint.control().next_command()?;
         let start = Instant::now();
@@ -82,14 +94,12 @@ pub fn serve<E: ControlPort, H: Handler<E>>(
             }),
             command_kind::ADVANCE => handler.advance(endpoint, &command).map(|p| {
                 last = p;
-                Reply::done(p.step, p.t, p.dt_stable, 0.0, 0.0)
+                p.reply()
             }),
-            command_kind::CHECKPOINT => handler
-                .checkpoint(endpoint, &command.tag_str())
-                .map(|()| Reply::done(last.step, last.t, last.dt_stable, 0.0, 0.0)),
-            command_kind::FINISH => handler
-                .finish(endpoint)
-                .map(|()| Reply::done(last.step, last.t, last.dt_stable, 0.0, 0.0)),
+            command_kind::CHECKPOINT => {
+                handler.checkpoint(endpoint, &command.tag_str()).map(|()| last.reply())
+            }
+            command_kind::FINISH => handler.finish(endpoint).map(|()| last.reply()),
             k => Err(Failure::new(failure_code::PROTOCOL, format!("unknown command kind {k}"))),
         };
         let waited = endpoint.control().waited().as_secs_f64();

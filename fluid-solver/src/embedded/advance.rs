@@ -77,6 +77,11 @@ pub struct EmbeddedRun {
     pub loads: Vec<[f64; 3]>,
     /// Cavitation clips of `p*` counted in the loads passes.
     pub clips: u64,
+    /// The work of the nodal loads on the surface since t = 0 along its motion, the fluid's half
+    /// of the interface energy balance (PROTOCOL.md §3, `interface_work`): each step from `t_a`
+    /// to `t_b` adds `Σ_nodes (f_a + f_b)/2 · (x_b - x_a)`, the trapezoidal rule along the path
+    /// the surface took (the Hermite path, coupled).
+    pub interface_work: f64,
     /// Seconds spent tracking (refit, intersect, sides, fill) and in the loads.
     pub tracking_s: f64,
     pub loads_s: f64,
@@ -153,6 +158,7 @@ impl EmbeddedRun {
             interface,
             loads,
             clips: 0,
+            interface_work: 0.0,
             tracking_s: 0.0,
             loads_s: 0.0,
             wall_flux_s: 0.0,
@@ -227,6 +233,7 @@ impl EmbeddedRun {
         // Tracking: from the surface at t_b to the step's view (the CFL step is the fluid's).
         let start = std::time::Instant::now();
         let (x, v) = self.kinematics.sample(t_b);
+        let x_a = tracker.surface.x_b.clone();
         let was_active = tracker.active.clone();
         let tracker = &mut self.tracker;
         let changes = tracker.advance(&semi.mesh, t_b, &x, &v)?;
@@ -309,10 +316,19 @@ impl EmbeddedRun {
         }
         self.wall_pressures(semi, &step, &ws.prim, &ws.grad)?;
         self.step = Some(step);
-        let mut loads = std::mem::take(&mut self.loads);
+        let loads_a = std::mem::take(&mut self.loads);
+        let mut loads = loads_a.clone();
         // A new topology may add surface nodes.
         loads.resize(self.tracker.surface.n_nodes(), [0.0; 3]);
         self.write_loads(semi, &mut loads)?;
+        // Nodes a new topology added this step start where they were published: no work yet.
+        self.interface_work += (0..x_a.len().min(loads_a.len()))
+            .map(|n| {
+                (0..3)
+                    .map(|k| 0.5 * (loads_a[n][k] + loads[n][k]) * (x[n][k] - x_a[n][k]))
+                    .sum::<f64>()
+            })
+            .sum::<f64>();
         self.loads = loads;
         let (mut f, mut m) = ([0.0; 3], [0.0; 3]);
         for (load, x) in self.loads.iter().zip(&x) {
@@ -353,7 +369,8 @@ impl EmbeddedRun {
         Ok(())
     }
 
-    /// `p*` at the current state, before any step (the coupled run's load at `Init`).
+    /// `p*` and the nodal loads at the current state, before any step (the coupled run's load
+    /// at `Init`).
     pub fn start_pressures(
         &mut self,
         semi: &Semidiscretization,
@@ -364,7 +381,12 @@ impl EmbeddedRun {
         if step.interface == InterfaceTreatment::SecondOrder {
             step.gradient.compute(&semi.mesh, prim, &mut grad);
         }
-        self.wall_pressures(semi, &step, prim, &grad)
+        self.wall_pressures(semi, &step, prim, &grad)?;
+        // The loads at the start, from which the first step's work is counted.
+        let mut loads = std::mem::take(&mut self.loads);
+        self.write_loads(semi, &mut loads)?;
+        self.loads = loads;
+        Ok(())
     }
 
     /// The nodal loads on the structure (Alg. 5.3 or 5.4, both sides of a shell summed) at the

@@ -3,8 +3,8 @@
 //! that the case cannot give back: the node status and sides (Alg. 4.2 step 5 redecides only the
 //! swept nodes, so the sides are the run's history, not the surface's geometry), the surface's
 //! nodal states at both ends of the last step and their times, `p*` at the cut edges and the
-//! nodal loads of the last step, the cavitation clips counted so far, and a coupled run's own
-//! copy of the Hermite path (DESIGN §4).
+//! nodal loads of the last step, the cavitation clips and the interface work counted so far, and
+//! a coupled run's own copy of the Hermite path (DESIGN §4).
 //!
 //! The rest is rebuilt exactly: the hierarchy is built at `t = 0` from the case as the run built
 //! it and refitted to the restored states (a refit depends only on them), the cut edges are
@@ -51,6 +51,8 @@ pub struct Saved {
     /// Nodal loads at `t_b`, in surface node order.
     pub loads: Vec<[f64; 3]>,
     pub clips: u64,
+    /// [`EmbeddedRun::interface_work`] at `t_b`.
+    pub interface_work: f64,
 }
 
 /// What a step changed in the fluid state, to undo it when the step fails.
@@ -78,6 +80,7 @@ struct Meta {
     t_a: f64,
     t_b: f64,
     clips: u64,
+    interface_work: f64,
     /// A coupled run's Hermite path `[t_a, t_b]` (its end states are arrays).
     coupled: Option<[f64; 2]>,
 }
@@ -112,6 +115,7 @@ impl EmbeddedRun {
             p_star: self.tracker.p_star.clone(),
             loads: self.loads.clone(),
             clips: self.clips,
+            interface_work: self.interface_work,
         }
     }
 
@@ -140,6 +144,7 @@ impl EmbeddedRun {
         tracker.p_star = saved.p_star;
         self.loads = saved.loads;
         self.clips = saved.clips;
+        self.interface_work = saved.interface_work;
         self.clear_view();
         Ok(())
     }
@@ -208,6 +213,7 @@ pub fn write(
         t_a: s.t_a,
         t_b: s.t_b,
         clips: run.clips,
+        interface_work: run.interface_work,
         coupled,
     })?;
     ck.put("status", t.sides.status.iter().map(|s| *s as u8).collect::<Vec<u8>>())?;
@@ -357,6 +363,7 @@ impl EmbeddedCheckpoint {
             p_star: ck.f64_n::<2>("p_star")?,
             loads: loads?,
             clips: meta.clips,
+            interface_work: meta.interface_work,
         };
         let kinematics = match (kinematics, meta.coupled) {
             (Kinematics::Law { .. }, Some(_)) => {

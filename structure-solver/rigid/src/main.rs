@@ -101,7 +101,7 @@ fn run(args: &RunArgs) -> Result<(), String> {
         n_surface_nodes: solver.n_nodes() as u64,
         n_surface_elements: n_elements,
         case_hash: case.hash(),
-        capabilities: capability::RESTART,
+        capabilities: capability::RESTART | capability::INTERFACE_WORK,
     };
     let mut endpoint =
         StructureEndpoint::open(run_id, info, Timeouts::from_secs(case.coupling.timeout_s))

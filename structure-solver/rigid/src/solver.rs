@@ -273,7 +273,12 @@ impl Handler<StructureEndpoint> for RigidSolver {
                 ))
             }
         }
-        Ok(Progress { step: c.step, t: self.t, dt_stable: self.dt_stable() })
+        Ok(Progress {
+            step: c.step,
+            t: self.t,
+            dt_stable: self.dt_stable(),
+            interface_work: self.scheme.interface_work(),
+        })
     }
 
     fn checkpoint(&mut self, _ep: &mut StructureEndpoint, tag: &str) -> Result<(), Failure> {

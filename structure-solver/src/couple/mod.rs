@@ -253,7 +253,7 @@ impl Participant {
             n_surface_nodes: self.wet.nodes.len() as u64,
             n_surface_elements: self.wet.elements.len() as u64,
             case_hash: case.hash(),
-            capabilities: capability::RESTART,
+            capabilities: capability::RESTART | capability::INTERFACE_WORK,
         }
     }
 
@@ -524,7 +524,12 @@ impl Handler<StructureEndpoint> for Participant {
                 ))
             }
         }
-        Ok(Progress { step: c.step, t: self.t, dt_stable: self.dt_stable })
+        Ok(Progress {
+            step: c.step,
+            t: self.t,
+            dt_stable: self.dt_stable,
+            interface_work: self.scheme.interface_work(),
+        })
     }
 
     fn checkpoint(&mut self, _ep: &mut StructureEndpoint, tag: &str) -> Result<(), Failure> {

@@ -141,7 +141,7 @@ impl<E> Handler<E> for Scripted {
         if c.scheme_phase != START {
             self.steps = c.step + 1;
         }
-        Ok(Progress { step: c.step, t: c.t_to, dt_stable: f64::INFINITY })
+        Ok(Progress { step: c.step, t: c.t_to, dt_stable: f64::INFINITY, interface_work: 0.0 })
     }
     fn checkpoint(&mut self, _: &mut E, _: &str) -> Result<(), Failure> {
         use interface_protocol::messages::command_kind::CHECKPOINT;

@@ -157,7 +157,7 @@ impl Handler<FluidEndpoint> for Piston {
         // Every fluid Advance (NONE, or C0's START half step) returns the load at t_to for the
         // face state received for t_to.
         self.respond(ep, c.step, c.t_to, c.t_to - c.t_from)?;
-        Ok(Progress { step: c.step, t: c.t_to, dt_stable: f64::INFINITY })
+        Ok(Progress { step: c.step, t: c.t_to, dt_stable: f64::INFINITY, interface_work: 0.0 })
     }
 
     fn checkpoint(&mut self, _ep: &mut FluidEndpoint, _tag: &str) -> Result<(), Failure> {
