@@ -3,8 +3,8 @@
 //! participants.
 //!
 //! Build the binaries for the profile the tests run with, then test:
-//! `cargo build --release -p coupler-scripts -p rigid-structure -p fsi-system-tests --bins &&
-//! cargo test --release -p fsi-system-tests`.
+//! `cargo build --release -p coupler-scripts -p rigid-structure -p fluid-solver -p
+//! structure-solver -p fsi-system-tests --bins && cargo test --release -p fsi-system-tests`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
@@ -26,7 +26,7 @@ pub fn bin(name: &str) -> PathBuf {
     assert!(
         p.is_file(),
         "{} is missing: build the binaries first with `cargo build{} -p coupler-scripts -p \
-         rigid-structure -p fsi-system-tests --bins`",
+         rigid-structure -p fluid-solver -p structure-solver -p fsi-system-tests --bins`",
         p.display(),
         if cfg!(debug_assertions) { "" } else { " --release" }
     );

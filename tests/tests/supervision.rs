@@ -3,12 +3,80 @@
 //! `Failed`, a run id used twice. Each ends with a clear error within its deadline, no process
 //! left and no shared-memory file of the run remaining. Every case here has `timeout_s <= 2`;
 //! `scripts/fault-loop` runs this file repeatedly.
+//!
+//! The faults of a running pair (a participant killed or stopped, `fsi` killed, `SIGTERM` to
+//! `fsi`) run one test body for each [`Pair`]: the analytic participants (`piston-fluid` and
+//! `rigid-structure`) and the real solvers (`fluid-solver` and `structure-solver` on
+//! `cases/gas-piston/case-structure.toml`, coarsened, made endless and given the test's
+//! timeout through `--set`).
 
 use fsi_system_tests::{
     alive, run_files, signal, unique_run_id, wait_gone, Finished, Fsi, Scratch,
 };
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+/// The participant pair of a fault test and how to start its endless run.
+#[derive(Debug, Clone, Copy)]
+enum Pair {
+    /// `piston-fluid` and `rigid-structure` on `endless_case`.
+    Analytic,
+    /// `fluid-solver` (embedded plate) and `structure-solver` (a rigid part on a spring) on
+    /// `cases/gas-piston/case-structure.toml`.
+    Solvers,
+}
+
+/// One participant of a pair.
+#[derive(Debug, Clone, Copy)]
+enum Side {
+    Fluid,
+    Structure,
+}
+
+impl Side {
+    fn other(self) -> Side {
+        match self {
+            Side::Fluid => Side::Structure,
+            Side::Structure => Side::Fluid,
+        }
+    }
+}
+
+impl Pair {
+    /// The program name of `side`.
+    fn name(self, side: Side) -> &'static str {
+        match (self, side) {
+            (Pair::Analytic, Side::Fluid) => "piston-fluid",
+            (Pair::Analytic, Side::Structure) => "rigid-structure",
+            (Pair::Solvers, Side::Fluid) => "fluid-solver",
+            (Pair::Solvers, Side::Structure) => "structure-solver",
+        }
+    }
+
+    /// Starts a run that only ends when the test ends it, with `timeout_s`, its output in
+    /// `<scratch>/out`; returns `fsi` once both participants are stepping, with them as
+    /// (pid, name).
+    fn start(self, scratch: &Scratch, timeout_s: f64) -> (Fsi, PathBuf, Vec<(i32, String)>) {
+        let out = scratch.path().join("out");
+        let fsi = match self {
+            Pair::Analytic => Fsi::run(scratch, &endless_case(scratch, timeout_s), &out, &[]),
+            Pair::Solvers => {
+                let case = Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("../cases/gas-piston/case-structure.toml");
+                let sets = [
+                    "coupling.t_end=1e3".to_string(),
+                    format!("coupling.timeout_s={timeout_s:?}"),
+                    // dx = 0.05 m: the plate at 1.005 m between the nodes at 1.00 and 1.05.
+                    "fluid.mesh.box.cells=[22,1,1]".into(),
+                ];
+                let args: Vec<&str> = sets.iter().flat_map(|s| ["--set", s.as_str()]).collect();
+                Fsi::run(scratch, &case, &out, &args)
+            }
+        };
+        let kids = running(&fsi, &out);
+        (fsi, out, kids)
+    }
+}
 
 /// A piston case that would run for hours: it only ends when a test ends it.
 fn endless_case(scratch: &Scratch, timeout_s: f64) -> PathBuf {
@@ -106,13 +174,11 @@ fn assert_no_run_files(run_id: &str) {
 
 /// SIGKILL of one participant: fsi exits non-zero within 1 s naming it and the signal, the
 /// other participant is gone and no file of the run remains.
-fn kill_participant(victim: &str, survivor: &str) {
+fn kill_participant(pair: Pair, side: Side) {
+    let (victim, survivor) = (pair.name(side), pair.name(side.other()));
     let scratch = Scratch::new();
-    let case = endless_case(&scratch, 2.0);
-    let out = scratch.path().join("out");
-    let fsi = Fsi::run(&scratch, &case, &out, &[]);
+    let (fsi, _, kids) = pair.start(&scratch, 2.0);
     let run_id = fsi.run_id.clone();
-    let kids = running(&fsi, &out);
     let (v, s) = (pid_of(&kids, victim), pid_of(&kids, survivor));
     let killed = Instant::now();
     signal(v, libc::SIGKILL);
@@ -127,22 +193,30 @@ fn kill_participant(victim: &str, survivor: &str) {
 
 #[test]
 fn killing_the_structure_stops_the_run_within_a_second() {
-    kill_participant("rigid-structure", "piston-fluid");
+    kill_participant(Pair::Analytic, Side::Structure);
 }
 
 #[test]
 fn killing_the_fluid_stops_the_run_within_a_second() {
-    kill_participant("piston-fluid", "rigid-structure");
+    kill_participant(Pair::Analytic, Side::Fluid);
 }
 
 #[test]
-fn killing_fsi_ends_both_participants_and_a_later_run_removes_its_files() {
+fn killing_the_structure_solver_stops_the_run_within_a_second() {
+    kill_participant(Pair::Solvers, Side::Structure);
+}
+
+#[test]
+fn killing_the_fluid_solver_stops_the_run_within_a_second() {
+    kill_participant(Pair::Solvers, Side::Fluid);
+}
+
+/// SIGKILL of fsi: both participants exit within 1 s, and the next launcher (whatever its run
+/// id) removes the files the dead run left.
+fn kill_fsi(pair: Pair) {
     let scratch = Scratch::new();
-    let case = endless_case(&scratch, 2.0);
-    let out = scratch.path().join("out");
-    let fsi = Fsi::run(&scratch, &case, &out, &[]);
+    let (fsi, _, kids) = pair.start(&scratch, 2.0);
     let run_id = fsi.run_id.clone();
-    let kids = running(&fsi, &out);
     let pids: Vec<i32> = kids.iter().map(|k| k.0).collect();
     signal(fsi.pid(), libc::SIGKILL);
     let gone = wait_gone(&pids, Duration::from_secs(5));
@@ -164,15 +238,22 @@ fn killing_fsi_ends_both_participants_and_a_later_run_removes_its_files() {
     assert!(still.is_empty(), "the later run left files of the dead run: {still:?} (of {left:?})");
 }
 
+#[test]
+fn killing_fsi_ends_both_participants_and_a_later_run_removes_its_files() {
+    kill_fsi(Pair::Analytic);
+}
+
+#[test]
+fn killing_fsi_ends_both_solvers_and_a_later_run_removes_its_files() {
+    kill_fsi(Pair::Solvers);
+}
+
 /// `signal` to fsi: it exits with 128 + signal, naming it; both participants are gone, no file
 /// of the run remains and `run.json` says the run was interrupted and by what.
-fn stop_fsi_with(signal_number: i32, name: &str) {
+fn stop_fsi_with(pair: Pair, signal_number: i32, name: &str) {
     let scratch = Scratch::new();
-    let case = endless_case(&scratch, 2.0);
-    let out = scratch.path().join("out");
-    let fsi = Fsi::run(&scratch, &case, &out, &[]);
+    let (fsi, out, kids) = pair.start(&scratch, 2.0);
     let run_id = fsi.run_id.clone();
-    let kids = running(&fsi, &out);
     signal(fsi.pid(), signal_number);
     let done = fsi.wait(Duration::from_secs(5));
     println!("fsi got {name}: exited after {:?}: {}", done.elapsed, done.stderr.trim());
@@ -189,12 +270,17 @@ fn stop_fsi_with(signal_number: i32, name: &str) {
 
 #[test]
 fn sigterm_to_fsi_stops_both_participants_cleanly() {
-    stop_fsi_with(libc::SIGTERM, "SIGTERM");
+    stop_fsi_with(Pair::Analytic, libc::SIGTERM, "SIGTERM");
+}
+
+#[test]
+fn sigterm_to_fsi_stops_both_solvers_cleanly() {
+    stop_fsi_with(Pair::Solvers, libc::SIGTERM, "SIGTERM");
 }
 
 #[test]
 fn sighup_to_fsi_stops_both_participants_cleanly() {
-    stop_fsi_with(libc::SIGHUP, "SIGHUP");
+    stop_fsi_with(Pair::Analytic, libc::SIGHUP, "SIGHUP");
 }
 
 #[test]
@@ -289,14 +375,12 @@ fn a_missing_participant_binary_is_named_at_once() {
 
 /// SIGSTOP of one participant: fsi blames it (whose reply is missing), never the other one
 /// (whose own wait for a command is longer than the launcher's for a reply), after the timeout.
-fn stop_participant(victim: &str, other: &str) {
+fn stop_participant(pair: Pair, side: Side) {
+    let (victim, other) = (pair.name(side), pair.name(side.other()));
     let scratch = Scratch::new();
     let timeout_s = 1.0;
-    let case = endless_case(&scratch, timeout_s);
-    let out = scratch.path().join("out");
-    let fsi = Fsi::run(&scratch, &case, &out, &[]);
+    let (fsi, _, kids) = pair.start(&scratch, timeout_s);
     let run_id = fsi.run_id.clone();
-    let kids = running(&fsi, &out);
     let v = pid_of(&kids, victim);
     let stopped = Instant::now();
     signal(v, libc::SIGSTOP);
@@ -319,12 +403,22 @@ fn stop_participant(victim: &str, other: &str) {
 
 #[test]
 fn a_stopped_fluid_is_blamed_after_the_timeout() {
-    stop_participant("piston-fluid", "rigid-structure");
+    stop_participant(Pair::Analytic, Side::Fluid);
 }
 
 #[test]
 fn a_stopped_structure_is_blamed_after_the_timeout() {
-    stop_participant("rigid-structure", "piston-fluid");
+    stop_participant(Pair::Analytic, Side::Structure);
+}
+
+#[test]
+fn a_stopped_fluid_solver_is_blamed_after_the_timeout() {
+    stop_participant(Pair::Solvers, Side::Fluid);
+}
+
+#[test]
+fn a_stopped_structure_solver_is_blamed_after_the_timeout() {
+    stop_participant(Pair::Solvers, Side::Structure);
 }
 
 #[test]
