@@ -6,6 +6,8 @@
 //! `cargo build --release -p coupler-scripts -p rigid-structure -p fluid-solver -p
 //! structure-solver -p fsi-system-tests --bins && cargo test --release -p fsi-system-tests`.
 
+pub mod order;
+
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
