@@ -234,7 +234,7 @@ pub fn run_files(run_id: &str) -> Vec<PathBuf> {
     interface_protocol::shm::run_files(run_id)
 }
 
-/// A probes CSV file: the header and the rows.
+/// A probes CSV file: the header and the rows (lines starting with `#` are comments).
 pub struct Probes {
     pub columns: Vec<String>,
     pub rows: Vec<Vec<f64>>,
@@ -244,7 +244,7 @@ impl Probes {
     pub fn read(path: &Path) -> Probes {
         let text = std::fs::read_to_string(path)
             .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+        let mut lines = text.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
         let columns: Vec<String> =
             lines.next().expect("a header").split(',').map(|c| c.trim().to_string()).collect();
         let rows = lines
