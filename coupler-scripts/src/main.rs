@@ -60,6 +60,10 @@ enum Cmd {
     Plot {
         /// A run folder (holding probes.csv and/or structure_probes.csv).
         dir: PathBuf,
+        /// A history to draw beside a probe column: COLUMN=FILE, the file a CSV of time and
+        /// value (`#` lines are comments), e.g. tip.ux=cases/shock-panel/m2c-tip.csv.
+        #[arg(long = "reference", value_name = "COLUMN=FILE")]
+        references: Vec<String>,
     },
 }
 
@@ -131,7 +135,12 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Cmd::Plot { dir } => match plot::plot_dir(&dir) {
+        Cmd::Plot { dir, references } => match references
+            .iter()
+            .map(|r| plot::Reference::parse(r))
+            .collect::<anyhow::Result<Vec<_>>>()
+            .and_then(|r| plot::plot_dir(&dir, &r))
+        {
             Ok(files) => {
                 for f in files {
                     println!("{}", f.display());

@@ -1,6 +1,7 @@
-//! `fsi plot DIR`: one PNG per probe column of the run's probe files (`probes.csv`,
-//! `structure_probes.csv`), against time. Plain line plots for a first look; ParaView is the tool
-//! for fields.
+//! `fsi plot DIR [--reference COLUMN=FILE]...`: one PNG per probe column of the run's probe files
+//! (`probes.csv`, `structure_probes.csv`), against time, with a published or exact history drawn
+//! beside a column where one is given (a CSV of time and one value column, `#` lines comments).
+//! Plain line plots for a first look; ParaView is the tool for fields.
 
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -29,7 +30,8 @@ pub fn read_csv(path: &Path) -> anyhow::Result<Table> {
         Some(i) => (&text[..=i], Some(text[..=i].matches('\n').count() + 1)),
         None => ("", Some(1)),
     };
-    let mut lines = whole.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let mut lines =
+        whole.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
     let (_, header) = lines.next().ok_or_else(|| match cut_line {
         Some(_) => anyhow::anyhow!("{}:1: the header line is cut short", path.display()),
         None => anyhow::anyhow!("{}: empty file", path.display()),
@@ -67,8 +69,38 @@ pub fn cut_warning(path: &Path, table: &Table) -> Option<String> {
     })
 }
 
-/// Writes `plots/<file stem>-<column>.png` in `dir` for every probe column; returns the files.
-pub fn plot_dir(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+/// A history to draw beside a probe column: `COLUMN=FILE` on the command line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reference {
+    /// The probe column it goes with (`tip.ux`).
+    pub column: String,
+    /// Its label (the file's stem) and points (time, value: the file's first two columns).
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+impl Reference {
+    /// Parses `COLUMN=FILE` and reads the file; errors name the argument or the file and line.
+    pub fn parse(arg: &str) -> anyhow::Result<Reference> {
+        let (column, file) = arg.split_once('=').ok_or_else(|| {
+            anyhow::anyhow!("--reference `{arg}`: expected COLUMN=FILE, e.g. tip.ux=m2c-tip.csv")
+        })?;
+        let path = Path::new(file);
+        let table = read_csv(path)?;
+        anyhow::ensure!(
+            table.columns.len() >= 2,
+            "{}: a reference needs a time column and a value column",
+            path.display()
+        );
+        let label = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let points = table.rows.iter().map(|r| (r[0], r[1])).collect();
+        Ok(Reference { column: column.to_string(), label, points })
+    }
+}
+
+/// Writes `plots/<file stem>-<column>.png` in `dir` for every probe column, with the
+/// `references` of that column beside it; returns the files.
+pub fn plot_dir(dir: &Path, references: &[Reference]) -> anyhow::Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     let found: Vec<PathBuf> =
         PROBE_FILES.iter().map(|f| dir.join(f)).filter(|p| p.is_file()).collect();
@@ -90,18 +122,26 @@ pub fn plot_dir(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
         for c in 1..table.columns.len() {
             let name = table.columns[c].replace(['/', ' '], "_");
             let png = plots.join(format!("{stem}-{name}.png"));
-            plot_column(&table, c, &png)?;
+            let beside: Vec<&Reference> =
+                references.iter().filter(|r| r.column == table.columns[c]).collect();
+            plot_column(&table, c, &beside, &png)?;
             written.push(png);
         }
     }
     Ok(written)
 }
 
-/// One column against time, 800 x 500 pixels.
-fn plot_column(table: &Table, c: usize, png: &Path) -> anyhow::Result<()> {
+/// One column against time, 800 x 500 pixels, with its references (red points, a legend).
+fn plot_column(
+    table: &Table,
+    c: usize,
+    references: &[&Reference],
+    png: &Path,
+) -> anyhow::Result<()> {
     let points: Vec<(f64, f64)> = table.rows.iter().map(|r| (r[0], r[c])).collect();
-    let (t0, t1) = range(points.iter().map(|p| p.0));
-    let (y0, y1) = range(points.iter().map(|p| p.1));
+    let all = || points.iter().chain(references.iter().flat_map(|r| r.points.iter()));
+    let (t0, t1) = range(all().map(|p| p.0));
+    let (y0, y1) = range(all().map(|p| p.1));
     let root = BitMapBackend::new(png, (800, 500)).into_drawing_area();
     let draw = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: {e}", png.display());
     root.fill(&WHITE).map_err(|e| draw(&e))?;
@@ -121,7 +161,24 @@ fn plot_column(table: &Table, c: usize, png: &Path) -> anyhow::Result<()> {
         .y_label_formatter(&|v| y_ticks.label(*v))
         .draw()
         .map_err(|e| draw(&e))?;
-    chart.draw_series(LineSeries::new(points, &BLUE)).map_err(|e| draw(&e))?;
+    let line = chart.draw_series(LineSeries::new(points, &BLUE)).map_err(|e| draw(&e))?;
+    if !references.is_empty() {
+        line.label("this run").legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE));
+        for r in references {
+            let marks = r.points.iter().map(|&p| Circle::new(p, 4, RED.filled()));
+            chart
+                .draw_series(marks)
+                .map_err(|e| draw(&e))?
+                .label(r.label.as_str())
+                .legend(|(x, y)| Circle::new((x + 10, y), 4, RED.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| draw(&e))?;
+    }
     root.present().map_err(|e| draw(&e))?;
     Ok(())
 }
@@ -214,7 +271,7 @@ mod tests {
             csv += &format!("{t},{},{}\n", (100.0 * t).sin(), 100.0 * (100.0 * t).cos());
         }
         std::fs::write(dir.path().join("structure_probes.csv"), csv).unwrap();
-        let files = plot_dir(dir.path()).unwrap();
+        let files = plot_dir(dir.path(), &[]).unwrap();
         assert_eq!(files.len(), 2);
         for f in &files {
             let bytes = std::fs::read(f).unwrap();
@@ -224,13 +281,32 @@ mod tests {
     }
 
     #[test]
+    fn a_reference_is_drawn_beside_its_column() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("structure_probes.csv"), "time,tip.ux\n0,0\n1,1\n2,4\n")
+            .unwrap();
+        let file = dir.path().join("published.csv");
+        std::fs::write(&file, "# a published history\ntime,ux\n0.5,0.2\n1.5,2.0\n").unwrap();
+        let r = Reference::parse(&format!("tip.ux={}", file.display())).unwrap();
+        assert_eq!((r.label.as_str(), r.points.len()), ("published", 2));
+        let plain = plot_dir(dir.path(), &[]).unwrap();
+        let plain = std::fs::read(&plain[0]).unwrap();
+        let with = plot_dir(dir.path(), &[r]).unwrap();
+        assert_ne!(std::fs::read(&with[0]).unwrap(), plain, "the reference changed nothing");
+        let e = Reference::parse("tip.ux").unwrap_err().to_string();
+        assert!(e.contains("COLUMN=FILE"), "{e}");
+        let e = Reference::parse("tip.ux=/no/such.csv").unwrap_err().to_string();
+        assert!(e.contains("/no/such.csv"), "{e}");
+    }
+
+    #[test]
     fn bad_rows_name_the_file_and_line() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("probes.csv"), "time,a.p\n0,1\n0.1,x\n").unwrap();
-        let e = plot_dir(dir.path()).unwrap_err().to_string();
+        let e = plot_dir(dir.path(), &[]).unwrap_err().to_string();
         assert!(e.contains("probes.csv:3"), "{e}");
         let empty = tempfile::tempdir().unwrap();
-        let e = plot_dir(empty.path()).unwrap_err().to_string();
+        let e = plot_dir(empty.path(), &[]).unwrap_err().to_string();
         assert!(e.contains("no probe file"), "{e}");
     }
 
@@ -246,11 +322,11 @@ mod tests {
         assert_eq!(table.cut_line, Some(4));
         let w = cut_warning(&path, &table).unwrap();
         assert!(w.contains("structure_probes.csv:4") && w.contains("cut short"), "{w}");
-        assert_eq!(plot_dir(dir.path()).unwrap().len(), 1);
+        assert_eq!(plot_dir(dir.path(), &[]).unwrap().len(), 1);
         // Cut in the middle of a row: the same.
         std::fs::write(&path, "time,piston.ux\n0,1e-3\n0.00").unwrap();
         assert_eq!(read_csv(&path).unwrap().cut_line, Some(3));
-        assert_eq!(plot_dir(dir.path()).unwrap().len(), 1);
+        assert_eq!(plot_dir(dir.path(), &[]).unwrap().len(), 1);
         // A whole file has no warning; a bad row that is whole stays an error.
         std::fs::write(&path, "time,piston.ux\n0,1e-3\n").unwrap();
         let table = read_csv(&path).unwrap();
