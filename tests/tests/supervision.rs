@@ -191,26 +191,6 @@ fn kill_participant(pair: Pair, side: Side) {
     assert_no_run_files(&run_id);
 }
 
-#[test]
-fn killing_the_structure_stops_the_run_within_a_second() {
-    kill_participant(Pair::Analytic, Side::Structure);
-}
-
-#[test]
-fn killing_the_fluid_stops_the_run_within_a_second() {
-    kill_participant(Pair::Analytic, Side::Fluid);
-}
-
-#[test]
-fn killing_the_structure_solver_stops_the_run_within_a_second() {
-    kill_participant(Pair::Solvers, Side::Structure);
-}
-
-#[test]
-fn killing_the_fluid_solver_stops_the_run_within_a_second() {
-    kill_participant(Pair::Solvers, Side::Fluid);
-}
-
 /// SIGKILL of fsi: both participants exit within 1 s, and the next launcher (whatever its run
 /// id) removes the files the dead run left.
 fn kill_fsi(pair: Pair) {
@@ -238,16 +218,6 @@ fn kill_fsi(pair: Pair) {
     assert!(still.is_empty(), "the later run left files of the dead run: {still:?} (of {left:?})");
 }
 
-#[test]
-fn killing_fsi_ends_both_participants_and_a_later_run_removes_its_files() {
-    kill_fsi(Pair::Analytic);
-}
-
-#[test]
-fn killing_fsi_ends_both_solvers_and_a_later_run_removes_its_files() {
-    kill_fsi(Pair::Solvers);
-}
-
 /// `signal` to fsi: it exits with 128 + signal, naming it; both participants are gone, no file
 /// of the run remains and `run.json` says the run was interrupted and by what.
 fn stop_fsi_with(pair: Pair, signal_number: i32, name: &str) {
@@ -266,21 +236,6 @@ fn stop_fsi_with(pair: Pair, signal_number: i32, name: &str) {
     assert_no_run_files(&run_id);
     let report = std::fs::read_to_string(out.join("run.json")).expect("run.json");
     assert_eq!(status_of(&report), format!("interrupted: {why}"), "{report}");
-}
-
-#[test]
-fn sigterm_to_fsi_stops_both_participants_cleanly() {
-    stop_fsi_with(Pair::Analytic, libc::SIGTERM, "SIGTERM");
-}
-
-#[test]
-fn sigterm_to_fsi_stops_both_solvers_cleanly() {
-    stop_fsi_with(Pair::Solvers, libc::SIGTERM, "SIGTERM");
-}
-
-#[test]
-fn sighup_to_fsi_stops_both_participants_cleanly() {
-    stop_fsi_with(Pair::Analytic, libc::SIGHUP, "SIGHUP");
 }
 
 #[test]
@@ -402,26 +357,6 @@ fn stop_participant(pair: Pair, side: Side) {
 }
 
 #[test]
-fn a_stopped_fluid_is_blamed_after_the_timeout() {
-    stop_participant(Pair::Analytic, Side::Fluid);
-}
-
-#[test]
-fn a_stopped_structure_is_blamed_after_the_timeout() {
-    stop_participant(Pair::Analytic, Side::Structure);
-}
-
-#[test]
-fn a_stopped_fluid_solver_is_blamed_after_the_timeout() {
-    stop_participant(Pair::Solvers, Side::Fluid);
-}
-
-#[test]
-fn a_stopped_structure_solver_is_blamed_after_the_timeout() {
-    stop_participant(Pair::Solvers, Side::Structure);
-}
-
-#[test]
 fn a_failed_reply_finishes_the_other_participant_and_reports_the_message() {
     let scratch = Scratch::new();
     let fluid = r#"["fake-participant", "--role", "fluid", "--fail-init", "mesh file cylinder.msh missing"]"#;
@@ -520,4 +455,32 @@ fn fsi_error(done: &Finished) -> String {
 #[test]
 fn run_ids_of_tests_are_unique() {
     assert_ne!(unique_run_id("a"), unique_run_id("a"));
+}
+
+/// One test per fault and participant pair, each a call of the fault's one body.
+macro_rules! fault_tests {
+    ($($name:ident: $body:expr;)*) => {
+        $(
+            #[test]
+            fn $name() {
+                $body
+            }
+        )*
+    };
+}
+
+fault_tests! {
+    killing_the_structure_stops_the_run_within_a_second: kill_participant(Pair::Analytic, Side::Structure);
+    killing_the_fluid_stops_the_run_within_a_second: kill_participant(Pair::Analytic, Side::Fluid);
+    killing_the_structure_solver_stops_the_run_within_a_second: kill_participant(Pair::Solvers, Side::Structure);
+    killing_the_fluid_solver_stops_the_run_within_a_second: kill_participant(Pair::Solvers, Side::Fluid);
+    killing_fsi_ends_both_participants_and_a_later_run_removes_its_files: kill_fsi(Pair::Analytic);
+    killing_fsi_ends_both_solvers_and_a_later_run_removes_its_files: kill_fsi(Pair::Solvers);
+    sigterm_to_fsi_stops_both_participants_cleanly: stop_fsi_with(Pair::Analytic, libc::SIGTERM, "SIGTERM");
+    sigterm_to_fsi_stops_both_solvers_cleanly: stop_fsi_with(Pair::Solvers, libc::SIGTERM, "SIGTERM");
+    sighup_to_fsi_stops_both_participants_cleanly: stop_fsi_with(Pair::Analytic, libc::SIGHUP, "SIGHUP");
+    a_stopped_fluid_is_blamed_after_the_timeout: stop_participant(Pair::Analytic, Side::Fluid);
+    a_stopped_structure_is_blamed_after_the_timeout: stop_participant(Pair::Analytic, Side::Structure);
+    a_stopped_fluid_solver_is_blamed_after_the_timeout: stop_participant(Pair::Solvers, Side::Fluid);
+    a_stopped_structure_solver_is_blamed_after_the_timeout: stop_participant(Pair::Solvers, Side::Structure);
 }
