@@ -191,8 +191,9 @@ fn the_python_checkpoint_is_a_checkpoint_part_and_a_bad_one_is_named() {
     let out = scratch.path().join("out");
     let command = python_structure();
     let set = ["--set", "coupling.t_end=8e-3", "--set", "output.checkpoint_every=4"];
-    let done = Fsi::run(&scratch, &spring_piston(), &out, &[&set[..], &["--set", &command]].concat())
-        .wait(Duration::from_secs(60));
+    let done =
+        Fsi::run(&scratch, &spring_piston(), &out, &[&set[..], &["--set", &command]].concat())
+            .wait(Duration::from_secs(60));
     assert!(done.status.success(), "fsi run failed:\n{}", done.stderr);
     let tag = out.join("checkpoints").join(tag_for_step(8));
     let ck = Checkpoint::read_file(&tag.join("structure.ckpt")).expect("a checkpoint part");
@@ -214,11 +215,12 @@ fn the_python_checkpoint_is_a_checkpoint_part_and_a_bad_one_is_named() {
     for name in ck.names().filter(|n| *n != "coupling.work") {
         broken.put(name, ck.f64(name).unwrap().to_vec()).unwrap();
     }
-    broken.write_file(&{
-        std::fs::create_dir_all(&bad).unwrap();
-        bad.join("structure.ckpt")
-    })
-    .unwrap();
+    broken
+        .write_file(&{
+            std::fs::create_dir_all(&bad).unwrap();
+            bad.join("structure.ckpt")
+        })
+        .unwrap();
     let wrapper = command.split('"').nth(1).unwrap().to_string();
     let run = std::process::Command::new(wrapper)
         .args(["run", spring_piston().to_str().unwrap(), "--couple", "nobody"])
@@ -228,4 +230,37 @@ fn the_python_checkpoint_is_a_checkpoint_part_and_a_bad_one_is_named() {
     let e = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success(), "a restart from {} succeeded", bad.display());
     assert!(e.contains("bad/structure.ckpt") && e.contains("`coupling.work`"), "{e}");
+}
+
+/// The energy ledger (`Staggered::interface_work`, reported in every reply): on the gas piston
+/// the structure's work in `run.json` of the Python body equals `rigid-structure`'s to the bit,
+/// for the three schemes (the fluid's work too: the same kinematics reached it).
+#[test]
+fn python_interface_work_equals_rigid_structures() {
+    let scratch = Scratch::new();
+    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/gas-piston/case.toml");
+    let command = python_structure();
+    for scheme in ["C0", "A6", "CSS"] {
+        let energy = |python: bool| {
+            let out = scratch.path().join(format!("{scheme}-{python}"));
+            let scheme_set = format!("coupling.scheme=\"{scheme}\"");
+            let mut args = vec!["--set", scheme_set.as_str(), "--set", "coupling.t_end=4e-3"];
+            if python {
+                args.extend(["--set", command.as_str()]);
+            }
+            let done = Fsi::run(&scratch, &case, &out, &args).wait(Duration::from_secs(60));
+            assert!(done.status.success(), "fsi run {scheme} failed:\n{}", done.stderr);
+            let run: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap())
+                    .unwrap();
+            let e = &run["interface_energy"];
+            let work = |k: &str| e[k].as_f64().unwrap_or_else(|| panic!("{scheme}: {k} in {e}"));
+            (work("structure_work"), work("fluid_work"))
+        };
+        let (rust, python) = (energy(false), energy(true));
+        println!("{scheme}: structure work {:e} J (rigid-structure {:e} J)", python.0, rust.0);
+        assert!(rust.0 > 0.0, "{scheme}: the structure's work {:e}", rust.0);
+        assert_eq!(python.0.to_bits(), rust.0.to_bits(), "{scheme}: structure work");
+        assert_eq!(python.1.to_bits(), rust.1.to_bits(), "{scheme}: fluid work");
+    }
 }
