@@ -35,9 +35,21 @@ CAPABILITY_RESTART, CAPABILITY_INTERFACE_WORK = 1, 2
 POLL_S = 0.05
 
 
-class Hello(ctypes.Structure):
+class _Wire(ctypes.Structure):
+    """A type of PROTOCOL §3: its fields in order in `_fields_`, its iceoryx2 type name in
+    `TYPE_NAME` (what the binding asks `type_name()` for)."""
+
+    TYPE_NAME = ""
+
+    @classmethod
+    def type_name(cls):
+        return cls.TYPE_NAME
+
+
+class Hello(_Wire):
     """`fsi::Hello::v1`, 48 bytes."""
 
+    TYPE_NAME = "fsi::Hello::v1"
     _fields_ = [
         ("protocol_version", ctypes.c_uint32),
         ("role", ctypes.c_uint32),
@@ -49,14 +61,11 @@ class Hello(ctypes.Structure):
         ("capabilities", ctypes.c_uint64),  # CAPABILITY_* bits (PROTOCOL.md §3)
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::Hello::v1"
 
-
-class Command(ctypes.Structure):
+class Command(_Wire):
     """`fsi::Command::v1`, 96 bytes."""
 
+    TYPE_NAME = "fsi::Command::v1"
     _fields_ = [
         ("kind", ctypes.c_uint32),
         ("scheme_phase", ctypes.c_uint32),
@@ -66,14 +75,11 @@ class Command(ctypes.Structure):
         ("tag", ctypes.c_uint8 * 64),
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::Command::v1"
 
-
-class Reply(ctypes.Structure):
+class Reply(_Wire):
     """`fsi::Reply::v1`, 312 bytes."""
 
+    TYPE_NAME = "fsi::Reply::v1"
     _fields_ = [
         ("kind", ctypes.c_uint32),
         ("code", ctypes.c_uint32),
@@ -86,14 +92,11 @@ class Reply(ctypes.Structure):
         ("interface_work", ctypes.c_double),
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::Reply::v1"
 
-
-class StepHeader(ctypes.Structure):
+class StepHeader(_Wire):
     """`fsi::StepHeader::v1`, 40 bytes: the user header of every surface sample."""
 
+    TYPE_NAME = "fsi::StepHeader::v1"
     _fields_ = [
         ("step", ctypes.c_uint64),
         ("time", ctypes.c_double),
@@ -102,34 +105,25 @@ class StepHeader(ctypes.Structure):
         ("count", ctypes.c_uint64),
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::StepHeader::v1"
 
-
-class NodeState(ctypes.Structure):
+class NodeState(_Wire):
     """`fsi::NodeState::v1`, 48 bytes: position and velocity of a wet node."""
 
+    TYPE_NAME = "fsi::NodeState::v1"
     _fields_ = [("x", ctypes.c_double * 3), ("v", ctypes.c_double * 3)]
 
-    @staticmethod
-    def type_name():
-        return "fsi::NodeState::v1"
 
-
-class NodeLoad(ctypes.Structure):
+class NodeLoad(_Wire):
     """`fsi::NodeLoad::v1`, 24 bytes: the fluid's force on a wet node."""
 
+    TYPE_NAME = "fsi::NodeLoad::v1"
     _fields_ = [("f", ctypes.c_double * 3)]
 
-    @staticmethod
-    def type_name():
-        return "fsi::NodeLoad::v1"
 
-
-class SurfaceElement(ctypes.Structure):
+class SurfaceElement(_Wire):
     """`fsi::SurfaceElement::v1`, 56 bytes: a triangle or quad of the wet surface."""
 
+    TYPE_NAME = "fsi::SurfaceElement::v1"
     _fields_ = [
         ("nodes", ctypes.c_uint32 * 4),
         ("n_nodes", ctypes.c_uint8),
@@ -137,10 +131,6 @@ class SurfaceElement(ctypes.Structure):
         ("padding", ctypes.c_uint8 * 6),
         ("phi", ctypes.c_double * 4),
     ]
-
-    @staticmethod
-    def type_name():
-        return "fsi::SurfaceElement::v1"
 
 
 for _t, _size in [(Hello, 48), (Command, 96), (Reply, 312), (StepHeader, 40), (NodeState, 48),

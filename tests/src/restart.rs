@@ -3,7 +3,7 @@
 //! uninterrupted run's (`tests/coupled_restart.rs`, `tests/python_peer.rs`).
 
 use crate::{unique_run_id, Fsi, Scratch};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// The probe files both participants write.
@@ -93,4 +93,26 @@ pub fn restart_is_bitwise(
         l.split(',').skip(1).take(3).map(|x| x.parse::<f64>().unwrap().abs()).collect::<Vec<_>>()
     });
     moved.fold(0.0, f64::max)
+}
+
+/// `cases/gas-piston`.
+pub fn gas_piston_case() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/gas-piston/case.toml")
+}
+
+/// [`restart_is_bitwise`] on the gas piston with `scheme` (and the `--set` overrides `extra`) at
+/// Δt = 2^-12 s (the case's is 2e-4 s), checkpoints every 8 steps; stopped after 20 steps
+/// (restart from 16), continued to 36. Returns the piston's largest displacement, checked to
+/// move (u0 = u_s = 0.714 m from its reference).
+pub fn gas_piston(scheme: &str, extra: &[String]) -> f64 {
+    let dt = 2f64.powi(-12);
+    let mut overrides = vec![
+        format!("coupling.scheme=\"{scheme}\""),
+        format!("coupling.dt={dt:e}"),
+        "output.checkpoint_every=8".to_string(),
+    ];
+    overrides.extend_from_slice(extra);
+    let moved = restart_is_bitwise(&gas_piston_case(), &overrides, dt, (16, 20, 36));
+    assert!(moved > 0.7, "{scheme}: the piston's displacement {moved:e}");
+    moved
 }

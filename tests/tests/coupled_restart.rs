@@ -11,27 +11,13 @@
 //!
 //! Build first: `cargo build --release --workspace --bins`.
 
-use fsi_system_tests::restart::{ok, restart_is_bitwise, sets};
+use fsi_system_tests::restart::{self, ok, restart_is_bitwise, sets};
 use fsi_system_tests::{unique_run_id, Fsi, Scratch};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
-fn gas_piston() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/gas-piston/case.toml")
-}
-
-/// The gas piston at Δt = 2^-12 s (the case's is 2e-4 s), checkpoints every 8 steps; stopped
-/// after 20 steps (restart from 16), continued to 36.
 fn gas_piston_restart(scheme: &str) {
-    let dt = 2f64.powi(-12);
-    let overrides = [
-        format!("coupling.scheme=\"{scheme}\""),
-        format!("coupling.dt={dt:e}"),
-        "output.checkpoint_every=8".to_string(),
-    ];
-    let moved = restart_is_bitwise(&gas_piston(), &overrides, dt, (16, 20, 36));
-    // u0 = u_s = 0.714 m: the piston's displacement from its reference.
-    assert!(moved > 0.7, "the piston's displacement {moved:e}");
+    restart::gas_piston(scheme, &[]);
 }
 
 #[test]
@@ -44,17 +30,12 @@ fn gas_piston_css_restart_continues_bitwise() {
     gas_piston_restart("CSS");
 }
 
-/// A clamped 0.2 m steel plate (MITC4, 4 x 4, 5 mm) in the plane z = 0, closing a column of air
-/// at 1e5 Pa below it (x, y in [0.075, 0.125], z in [-0.305, 0.105], dz = 0.01: the plate half-way
-/// between two node layers); no fluid above the plate.
+/// The clamped plate of `structure-solver/tests/clamped_plate.toml` (0.2 m steel, MITC4, 4 x 4,
+/// 5 mm) in the plane z = 0, closing a column of air at 1e5 Pa below it (x, y in [0.075, 0.125],
+/// z in [-0.305, 0.105], dz = 0.01: the plate half-way between two node layers); no fluid above
+/// the plate.
 fn plate_case(scheme: &str) -> String {
-    let edge = |name: &str, min: [f64; 3], max: [f64; 3]| {
-        format!("{name} = {{ min = {min:?}, max = {max:?} }}\n")
-    };
-    let bc = |set: &str| {
-        format!("[[structure.bc]]\nset = \"{set}\"\nfixed = [\"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\"]\n")
-    };
-    let (a, b, c, d) = (-1e-9, 1e-9, 0.2 - 1e-9, 0.2 + 1e-9);
+    const PLATE: &str = include_str!("../../structure-solver/tests/clamped_plate.toml");
     format!(
         r#"[case]
 name = "plate-air"
@@ -88,29 +69,10 @@ limiter = "van_albada"
 cfl = 0.5
 [fluid.time]
 t_end = 1e-4
-[structure]
-command = ["structure-solver"]
-mesh = {{ generator = "rectangle", lx = 0.2, ly = 0.2, nx = 4, ny = 4 }}
-material = {{ e = 200e9, nu = 0.3, rho = 7800.0 }}
-thickness = 0.005
-element = "mitc4"
-wet_set = "all"
-[[structure.probes]]
-name = "centre"
-point = [0.1, 0.1, 0.0]
 [output]
 fields_every = 0
 checkpoint_every = 8
-[structure.sets]
-{}{}{}{}{}{}{}{}"#,
-        edge("x0", [a, -1.0, -1.0], [b, 1.0, 1.0]),
-        edge("x1", [c, -1.0, -1.0], [d, 1.0, 1.0]),
-        edge("y0", [-1.0, a, -1.0], [1.0, b, 1.0]),
-        edge("y1", [-1.0, c, -1.0], [1.0, d, 1.0]),
-        bc("x0"),
-        bc("x1"),
-        bc("y0"),
-        bc("y1"),
+{PLATE}"#
     )
 }
 
@@ -137,7 +99,7 @@ fn mitc4_plate_a6_restart_continues_bitwise() {
 #[test]
 fn a_restart_without_a_matching_checkpoint_is_refused() {
     let scratch = Scratch::new();
-    let case = gas_piston();
+    let case = restart::gas_piston_case();
     let fsi = |dir: &Path, extra: &[&str]| {
         let id = unique_run_id("norestart");
         let mut args = vec!["run", case.to_str().unwrap(), "--quiet", "--run-id", &id];

@@ -6,7 +6,7 @@
 //!
 //! Needs the venv of `coupler-scripts/python/install.sh` (`scripts/install-deps.sh` runs it).
 
-use fsi_system_tests::restart::restart_is_bitwise;
+use fsi_system_tests::restart;
 use fsi_system_tests::{
     alive, python_structure, run_files, signal, Fsi, Oscillator, Probes, Scratch,
 };
@@ -148,24 +148,13 @@ fn killing_the_python_structure_stops_the_run() {
     assert!(left.is_empty(), "files of run {run_id} remain: {left:?}");
 }
 
-/// The gas piston (`cases/gas-piston`, `fluid-solver`) with the Python structure at Δt = 2^-12 s,
-/// checkpoints every 8 steps; stopped after 20 steps, restarted from 16 and continued to 36: both
-/// probe files equal the uninterrupted run's byte for byte, as for `rigid-structure`
-/// (`coupled_restart.rs`). The spring-piston case cannot restart: its `piston-fluid` does not
+/// The gas piston (`cases/gas-piston`, `fluid-solver`) with the Python structure, stopped and
+/// restarted as `coupled_restart.rs` does with `rigid-structure` (`restart::gas_piston`): both
+/// probe files equal the uninterrupted run's byte for byte. The spring-piston case cannot restart: its `piston-fluid` does not
 /// announce the capability.
 fn python_restart(scheme: &str) {
-    let dt = 2f64.powi(-12);
-    let overrides = [
-        format!("coupling.scheme=\"{scheme}\""),
-        format!("coupling.dt={dt:e}"),
-        "output.checkpoint_every=8".to_string(),
-        python_structure(),
-    ];
-    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/gas-piston/case.toml");
-    let moved = restart_is_bitwise(&case, &overrides, dt, (16, 20, 36));
+    let moved = restart::gas_piston(scheme, &[python_structure()]);
     println!("gas piston, Python structure, {scheme}: restart bitwise, |u| up to {moved:e} m");
-    // u0 = u_s = 0.714 m: the piston's displacement from its reference.
-    assert!(moved > 0.7, "the piston's displacement {moved:e}");
 }
 
 #[test]
@@ -238,7 +227,7 @@ fn the_python_checkpoint_is_a_checkpoint_part_and_a_bad_one_is_named() {
 #[test]
 fn python_interface_work_equals_rigid_structures() {
     let scratch = Scratch::new();
-    let case = Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/gas-piston/case.toml");
+    let case = restart::gas_piston_case();
     let command = python_structure();
     for scheme in ["C0", "A6", "CSS"] {
         let energy = |python: bool| {
