@@ -2,14 +2,15 @@
 
 A participant written in Python uses this module the way a Rust one uses `interface_protocol`:
 the wire types of PROTOCOL §3 (`messages.rs`), the run's iceoryx2 configuration and services of
-§1-§2 (`services.rs`, `endpoint/`), the command loop of §4 (`participant.rs`) and the liveness
-rules of §5 (`liveness.rs`). It needs the `iceoryx2==0.10.0` and `numpy` packages (see install.sh).
+§1-§2 (`services.rs`, `endpoint/`), the command loop of §4 (`participant.rs`), the liveness
+rules of §5 (`liveness.rs`) and the checkpoint part files of §4, restart (`io/checkpoint.rs`). It needs the `iceoryx2==0.10.0` and `numpy` packages (see install.sh).
 """
 
 import ctypes
 import gc
 import os
 import signal
+import struct
 import sys
 import time
 import tomllib
@@ -27,14 +28,28 @@ INIT, ADVANCE, CHECKPOINT, FINISH = 1, 2, 3, 4
 NONE, START, PREDICT, CORRECT = 0, 1, 2, 3
 READY, DONE, FAILED = 1, 2, 3
 CODE_PROTOCOL, CODE_SOLVER, CODE_OUTPUT, CODE_UNSUPPORTED = 1, 2, 3, 4
+# Hello.capabilities bits (`messages::capability`, PROTOCOL §3).
+CAPABILITY_RESTART, CAPABILITY_INTERFACE_WORK = 1, 2
 
 # A reader sleeps on its wake listener at most this long before it checks whether to stop (§2, §5).
 POLL_S = 0.05
 
 
-class Hello(ctypes.Structure):
+class _Wire(ctypes.Structure):
+    """A type of PROTOCOL §3: its fields in order in `_fields_`, its iceoryx2 type name in
+    `TYPE_NAME` (what the binding asks `type_name()` for)."""
+
+    TYPE_NAME = ""
+
+    @classmethod
+    def type_name(cls):
+        return cls.TYPE_NAME
+
+
+class Hello(_Wire):
     """`fsi::Hello::v1`, 48 bytes."""
 
+    TYPE_NAME = "fsi::Hello::v1"
     _fields_ = [
         ("protocol_version", ctypes.c_uint32),
         ("role", ctypes.c_uint32),
@@ -43,17 +58,14 @@ class Hello(ctypes.Structure):
         ("n_surface_nodes", ctypes.c_uint64),
         ("n_surface_elements", ctypes.c_uint64),
         ("case_hash", ctypes.c_uint64),
-        ("capabilities", ctypes.c_uint64),  # 0: no restart (PROTOCOL.md §3)
+        ("capabilities", ctypes.c_uint64),  # CAPABILITY_* bits (PROTOCOL.md §3)
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::Hello::v1"
 
-
-class Command(ctypes.Structure):
+class Command(_Wire):
     """`fsi::Command::v1`, 96 bytes."""
 
+    TYPE_NAME = "fsi::Command::v1"
     _fields_ = [
         ("kind", ctypes.c_uint32),
         ("scheme_phase", ctypes.c_uint32),
@@ -63,14 +75,11 @@ class Command(ctypes.Structure):
         ("tag", ctypes.c_uint8 * 64),
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::Command::v1"
 
-
-class Reply(ctypes.Structure):
+class Reply(_Wire):
     """`fsi::Reply::v1`, 312 bytes."""
 
+    TYPE_NAME = "fsi::Reply::v1"
     _fields_ = [
         ("kind", ctypes.c_uint32),
         ("code", ctypes.c_uint32),
@@ -83,14 +92,11 @@ class Reply(ctypes.Structure):
         ("interface_work", ctypes.c_double),
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::Reply::v1"
 
-
-class StepHeader(ctypes.Structure):
+class StepHeader(_Wire):
     """`fsi::StepHeader::v1`, 40 bytes: the user header of every surface sample."""
 
+    TYPE_NAME = "fsi::StepHeader::v1"
     _fields_ = [
         ("step", ctypes.c_uint64),
         ("time", ctypes.c_double),
@@ -99,34 +105,25 @@ class StepHeader(ctypes.Structure):
         ("count", ctypes.c_uint64),
     ]
 
-    @staticmethod
-    def type_name():
-        return "fsi::StepHeader::v1"
 
-
-class NodeState(ctypes.Structure):
+class NodeState(_Wire):
     """`fsi::NodeState::v1`, 48 bytes: position and velocity of a wet node."""
 
+    TYPE_NAME = "fsi::NodeState::v1"
     _fields_ = [("x", ctypes.c_double * 3), ("v", ctypes.c_double * 3)]
 
-    @staticmethod
-    def type_name():
-        return "fsi::NodeState::v1"
 
-
-class NodeLoad(ctypes.Structure):
+class NodeLoad(_Wire):
     """`fsi::NodeLoad::v1`, 24 bytes: the fluid's force on a wet node."""
 
+    TYPE_NAME = "fsi::NodeLoad::v1"
     _fields_ = [("f", ctypes.c_double * 3)]
 
-    @staticmethod
-    def type_name():
-        return "fsi::NodeLoad::v1"
 
-
-class SurfaceElement(ctypes.Structure):
+class SurfaceElement(_Wire):
     """`fsi::SurfaceElement::v1`, 56 bytes: a triangle or quad of the wet surface."""
 
+    TYPE_NAME = "fsi::SurfaceElement::v1"
     _fields_ = [
         ("nodes", ctypes.c_uint32 * 4),
         ("n_nodes", ctypes.c_uint8),
@@ -134,10 +131,6 @@ class SurfaceElement(ctypes.Structure):
         ("padding", ctypes.c_uint8 * 6),
         ("phi", ctypes.c_double * 4),
     ]
-
-    @staticmethod
-    def type_name():
-        return "fsi::SurfaceElement::v1"
 
 
 for _t, _size in [(Hello, 48), (Command, 96), (Reply, 312), (StepHeader, 40), (NodeState, 48),
@@ -298,6 +291,189 @@ def load_case(path, overrides):
     return doc, fnv1a64(canonical_toml(doc).encode("utf-8"))
 
 
+# ---- checkpoint parts `checkpoints/<tag>/<part>.ckpt` (PROTOCOL §4, `io::checkpoint`) ----
+#
+# The format of `interface_protocol::io::checkpoint`, version 1, all integers little-endian:
+# magic `FSICKPT\0`, u32 version, u32 array count, u64 step, f64 time, u64 metadata length m and
+# m bytes of metadata (postcard), then per array u16 name length, the UTF-8 name, u8 type (1 f64,
+# 2 u64, 3 u32, 4 u8), u64 element count and the elements; last the u64 checksum of every byte
+# before it (`checkpoint::checksum`).
+
+CKPT_MAGIC = b"FSICKPT\0"
+CKPT_VERSION = 1
+CKPT_EXTENSION = "ckpt"
+_CKPT_TYPES = {1: ("f64", "<f8"), 2: ("u64", "<u8"), 3: ("u32", "<u4"), 4: ("u8", "u1")}
+_FNV_BASIS, _FNV_PRIME, _U64 = 0xCBF29CE484222325, 0x100000001B3, 0xFFFFFFFFFFFFFFFF
+
+
+class CheckpointError(Exception):
+    """A checkpoint part that cannot be written or read; the message names the file."""
+
+
+def ckpt_checksum(data):
+    """FNV-1a over the little-endian u64 words of `data` (the last one zero-padded), then the
+    byte length folded in the same way."""
+    h = _FNV_BASIS
+    for (w,) in struct.iter_unpack("<Q", data + b"\0" * (-len(data) % 8)):
+        h = ((h ^ w) * _FNV_PRIME) & _U64
+    return ((h ^ len(data)) * _FNV_PRIME) & _U64
+
+
+def _varint(n):
+    out = bytearray()
+    while True:
+        byte, n = n & 0x7F, n >> 7
+        out.append(byte | (0x80 if n else 0))
+        if not n:
+            return bytes(out)
+
+
+def postcard_strings(names):
+    """A `Vec<String>` as postcard encodes it: varint count, then varint length and UTF-8 each."""
+    out = bytearray(_varint(len(names)))
+    for name in names:
+        data = name.encode("utf-8")
+        out += _varint(len(data)) + data
+    return bytes(out)
+
+
+def postcard_strings_decode(data):
+    """The `Vec<String>` of `postcard_strings`; ValueError if `data` is not exactly one."""
+    pos = 0
+
+    def varint():
+        nonlocal pos
+        n, shift = 0, 0
+        while True:
+            if pos >= len(data) or shift > 63:
+                raise ValueError("truncated varint")
+            byte = data[pos]
+            pos += 1
+            n |= (byte & 0x7F) << shift
+            shift += 7
+            if not byte & 0x80:
+                return n
+
+    names = []
+    for _ in range(varint()):
+        n = varint()
+        if pos + n > len(data):
+            raise ValueError("truncated string")
+        names.append(data[pos:pos + n].decode("utf-8"))
+        pos += n
+    if pos != len(data):
+        raise ValueError(f"{len(data) - pos} bytes after the list")
+    return names
+
+
+def write_atomic(path, data):
+    """Writes `path` as `io::atomic` does: `<name>.tmp.<pid>` beside it, fsync, rename over it,
+    fsync the folder; readers see the old file or the new one, never a part."""
+    tmp = f"{path}.tmp.{os.getpid()}"
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+        fd = os.open(os.path.dirname(os.path.abspath(path)), os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError as e:
+        try:
+            os.remove(tmp)
+        except OSError:
+            pass
+        raise CheckpointError(f"checkpoint `{path}`: writing {path}: {e.strerror}") from None
+
+
+def write_checkpoint(path, step, time_, meta, arrays):
+    """Writes the part `path` atomically: `step`, `time_`, the metadata bytes `meta` and
+    `arrays`, a list of (name, float64 values)."""
+    b = bytearray(CKPT_MAGIC)
+    b += struct.pack("<IIQdQ", CKPT_VERSION, len(arrays), step, time_, len(meta)) + meta
+    for name, values in arrays:
+        data = np.ascontiguousarray(values, dtype="<f8")
+        raw = name.encode("utf-8")
+        b += struct.pack("<H", len(raw)) + raw + struct.pack("<BQ", 1, data.size) + data.tobytes()
+    b += struct.pack("<Q", ckpt_checksum(bytes(b)))
+    write_atomic(path, bytes(b))
+
+
+class Checkpoint:
+    """A part read back by `read_checkpoint`: `step`, `time`, `meta` (bytes), `arrays` by name
+    (numpy arrays), `path`."""
+
+    def __init__(self, path, step, time_, meta, arrays):
+        self.path, self.step, self.time, self.meta, self.arrays = path, step, time_, meta, arrays
+
+    def f64(self, name, n=None):
+        """The f64 array `name`, of `n` values if given; the error names file and array."""
+        if name not in self.arrays:
+            raise CheckpointError(f"checkpoint `{self.path}` has no array `{name}` (it holds: "
+                                  f"{', '.join(self.arrays)})")
+        a = self.arrays[name]
+        if a.dtype != np.float64:
+            raise CheckpointError(f"checkpoint `{self.path}`: array `{name}` holds {a.dtype}, "
+                                  "not f64")
+        if n is not None and a.size != n:
+            raise CheckpointError(f"checkpoint `{self.path}`: `{name}` holds {a.size} values, "
+                                  f"expected {n}")
+        return a.astype(np.float64)
+
+
+def read_checkpoint(path):
+    """Reads and verifies the part `path`; a `CheckpointError` names the file and what is wrong
+    (missing, truncated, not a checkpoint, another version, a damaged checksum)."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError as e:
+        raise CheckpointError(f"checkpoint `{path}`: {e.strerror}") from None
+    pos = 0
+
+    def take(n, what):
+        nonlocal pos
+        if pos + n > len(data):
+            raise CheckpointError(f"checkpoint `{path}` is truncated: {what} needs bytes up to "
+                                  f"{pos + n}, the file has {len(data)}")
+        pos += n
+        return data[pos - n:pos]
+
+    def corrupt(reason):
+        return CheckpointError(f"checkpoint `{path}` is corrupt: {reason}")
+
+    if take(8, "the header") != CKPT_MAGIC:
+        raise corrupt("not a checkpoint file (bad magic bytes)")
+    version, count, step, time_, meta_len = struct.unpack("<IIQdQ", take(32, "the header"))
+    if version != CKPT_VERSION:
+        raise corrupt(f"format version {version}, this reader reads {CKPT_VERSION}")
+    meta = take(meta_len, "the metadata")
+    arrays = {}
+    for i in range(count):
+        (name_len,) = struct.unpack("<H", take(2, f"array {i}"))
+        try:
+            name = take(name_len, f"array {i}").decode("utf-8")
+        except UnicodeDecodeError:
+            raise corrupt(f"array {i} has a name that is not UTF-8") from None
+        code, n = struct.unpack("<BQ", take(9, f"array `{name}`"))
+        if code not in _CKPT_TYPES:
+            raise corrupt(f"array `{name}` has unknown type code {code}")
+        dtype = np.dtype(_CKPT_TYPES[code][1])
+        arrays[name] = np.frombuffer(take(n * dtype.itemsize, f"array `{name}`"), dtype=dtype)
+    body_end = pos
+    (stored,) = struct.unpack("<Q", take(8, "the checksum"))
+    if pos != len(data):
+        raise corrupt(f"{len(data) - pos} unexpected bytes after the checksum")
+    computed = ckpt_checksum(data[:body_end])
+    if stored != computed:
+        raise corrupt(f"checksum mismatch (stored {stored:016x}, computed {computed:016x}): the "
+                      "file was damaged")
+    return Checkpoint(path, step, time_, meta, arrays)
+
+
 # ---- liveness (PROTOCOL §5) ----
 
 _stop_signal = None
@@ -368,7 +544,7 @@ class StructurePeer:
     """The structure's ports of one run: control server, topology and kinematics publishers,
     loads subscriber, wake events; its `Hello` is published once they all exist."""
 
-    def __init__(self, run_id, n_nodes, n_elements, case_hash, timeout_s):
+    def __init__(self, run_id, n_nodes, n_elements, case_hash, timeout_s, capabilities=0):
         self.run_id = run_id
         self.timeout_s = timeout_s
         self.waited = 0.0
@@ -378,7 +554,7 @@ class StructurePeer:
                      .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
                      .create(iox2.ServiceType.Ipc))
         try:
-            self._open(n_nodes, n_elements, case_hash)
+            self._open(n_nodes, n_elements, case_hash, capabilities)
         except BaseException:
             self.close()
             raise
@@ -400,7 +576,7 @@ class StructurePeer:
     def _event(self, name):
         return self._keep(self._service(f"wake/{name}").event().open_or_create())
 
-    def _open(self, n_nodes, n_elements, case_hash):
+    def _open(self, n_nodes, n_elements, case_hash, capabilities):
         hello_svc = self._keep(
             self._service("hello/structure").publish_subscribe(Hello).history_size(1)
             .subscriber_max_buffer_size(1).enable_safe_overflow(True).open_or_create())
@@ -421,7 +597,7 @@ class StructurePeer:
         self.wake_launcher = self._keep(self._event("launcher").notifier_builder().create())
         hello = Hello(protocol_version=PROTOCOL_VERSION, role=ROLE_STRUCTURE, pid=os.getpid(),
                       units=UNITS_SI, n_surface_nodes=n_nodes, n_surface_elements=n_elements,
-                      case_hash=case_hash)
+                      case_hash=case_hash, capabilities=capabilities)
         self.hello_pub.send_copy(hello)
         self.wake_launcher.notify()
 
@@ -516,10 +692,11 @@ class StructurePeer:
 
 def serve(peer, handler):
     """Answers commands until `Finish` (PROTOCOL §4): `handler.init(peer)` returns dt_stable,
-    `handler.advance(peer, command)` returns (step, t, dt_stable), `handler.checkpoint(peer, tag)`
-    and `handler.finish(peer)`; a `Failure` becomes a `Failed` reply, the loop goes on until
+    `handler.advance(peer, command)` returns (step, t, dt_stable, interface_work),
+    `handler.checkpoint(peer, tag)` and `handler.finish(peer)`; `Checkpoint` and `Finish` repeat
+    the last `Advance`'s progress. A `Failure` becomes a `Failed` reply, the loop goes on until
     `Finish`."""
-    step, t, dt_stable = 0, 0.0, float("inf")
+    step, t, dt_stable, work = 0, 0.0, float("inf"), 0.0
     while True:
         request, command = peer.next_command()
         start = time.monotonic()
@@ -528,9 +705,9 @@ def serve(peer, handler):
         try:
             if command.kind == INIT:
                 dt_stable = handler.init(peer)
-                reply.kind, reply.dt_stable = READY, dt_stable
+                reply.kind = READY
             elif command.kind == ADVANCE:
-                step, t, dt_stable = handler.advance(peer, command)
+                step, t, dt_stable, work = handler.advance(peer, command)
                 reply.kind = DONE
             elif command.kind == CHECKPOINT:
                 handler.checkpoint(peer, read_fixed_str(command.tag))
@@ -541,6 +718,7 @@ def serve(peer, handler):
             else:
                 raise Failure(CODE_PROTOCOL, f"unknown command kind {command.kind}")
             reply.step, reply.t, reply.dt_stable = step, t, dt_stable
+            reply.interface_work = work if command.kind != INIT else 0.0
         except Failure as f:
             reply = Reply(kind=FAILED, code=f.code, dt_stable=dt_stable)
             write_fixed_str(f.message, reply.message)

@@ -2,7 +2,7 @@
 """A spring-mass-damper body speaking the FSI protocol: the Python twin of `rigid-structure`
 for translational DOFs (PROTOCOL §6).
 
-    spring_mass.py run CASE --couple RUN_ID --out DIR [--set key=value]...
+    spring_mass.py run CASE --couple RUN_ID --out DIR [--set key=value]... [--restart CKPT]
     spring_mass.py check CASE [--set key=value]...
 
 It reads `[structure.rigid]` with the keys of `rigid-structure` (mass, dofs among "x", "y",
@@ -10,6 +10,16 @@ It reads `[structure.rigid]` with the keys of `rigid-structure` (mass, dofs amon
 wet_elements, probe), steps the body with the staggered scheme of `[coupling]` (CSS, C0, A6:
 `staggered.py`, the formulas of `interface_protocol::coupling`) and writes
 `structure_probes.csv` as `rigid-structure` does.
+
+At `Checkpoint { tag }` it writes `OUT/checkpoints/<tag>/structure.ckpt` atomically, in the
+project's checkpoint format (`fsi_peer.write_checkpoint`, that of `interface_protocol::io::
+checkpoint`) and with the content of `rigid-structure`'s part: the step and time of the header,
+the DOF names as metadata (a postcard `Vec<String>`), the f64 arrays `u`, `v`, `a`, `v_half` (one
+value per DOF) and `coupling.<name>` for each entry of the scheme's history (`staggered.HISTORY`:
+`f_half`, `v_half_prev`, `a_hat`, `f_prev`, `times` = [t^n, t_prev, t_half], `f_applied`,
+`work`). `--restart CKPT` (the launcher's `fsi run --restart`: a checkpoint tag folder, or a run
+folder whose newest `checkpoints/<tag>/structure.ckpt` is taken) reads it back and continues
+bitwise; `structure_probes.csv` keeps its rows up to the checkpoint's time.
 """
 
 import argparse
@@ -23,12 +33,15 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import fsi_peer  # noqa: E402
-from fsi_peer import Failure, StepHeader, SurfaceElement  # noqa: E402
-from staggered import Oscillators, Staggered  # noqa: E402
+from fsi_peer import CheckpointError, Failure, StepHeader, SurfaceElement  # noqa: E402
+from staggered import HISTORY, Oscillators, Staggered  # noqa: E402
 
 PROG = "spring_mass"
 AXES = ["x", "y", "z"]
 COMPONENTS = ["ux", "uy", "uz", "vx", "vy", "vz"]
+# The checkpoint part this solver writes: `checkpoints/<tag>/structure.ckpt`.
+PART = "structure"
+CAPABILITIES = fsi_peer.CAPABILITY_RESTART | fsi_peer.CAPABILITY_INTERFACE_WORK
 
 
 class CaseError(Exception):
@@ -192,19 +205,53 @@ def n_steps(dt, t_end):
 class SpringMass:
     """The body through the coupling sequence, as `rigid-structure`'s RigidSolver."""
 
-    def __init__(self, body, out_dir):
+    def __init__(self, body, out_dir, restart=None):
         self.body = body
+        self.out = out_dir
         self.state = Oscillators([body.mass] * len(body.dofs), body.k, body.c, body.u0, body.v0)
         self.scheme = Staggered(body.scheme, len(body.dofs))
         self.first_dt = min(body.dt, body.t_end)
         self.t = 0.0
+        self.steps = 0
+        kept = ""
         path = os.path.join(out_dir, "structure_probes.csv")
+        header = "time" + "".join(f",{body.probe}.{c}" for c in COMPONENTS)
+        if restart is not None:
+            self.restore(restart_part(restart))
+            kept = rows_until(path, header, self.t)
         try:
             self.probes = open(path, "w", encoding="utf-8")
-            self.probes.write("time" + "".join(f",{body.probe}.{c}" for c in COMPONENTS) + "\n")
+            self.probes.write(header + "\n" + kept)
             self.probes.flush()
         except OSError as e:
             raise CaseError(f"cannot create the probe file {path}: {e.strerror}") from None
+
+    def restore(self, path):
+        """Puts back the state, the scheme's history, the step and the time of the part `path`
+        (written by `checkpoint`); the error names the file and the array that does not fit."""
+        try:
+            ck = fsi_peer.read_checkpoint(path)
+            try:
+                names = fsi_peer.postcard_strings_decode(ck.meta)
+            except (ValueError, UnicodeDecodeError) as e:
+                raise CheckpointError(f"checkpoint `{path}`: metadata: {e} (expected the DOF "
+                                      "names)") from None
+            if names != self.body.dofs:
+                raise CheckpointError(f"checkpoint `{path}`: it holds the DOFs {names}, the "
+                                      f"case's structure.rigid.dofs are {self.body.dofs}")
+            n = len(names)
+            d = self.state
+            d.u, d.v, d.a, d.v_half = (ck.f64(k, n) for k in ("u", "v", "a", "v_half"))
+            missing = [k for k in HISTORY if f"coupling.{k}" not in ck.arrays]
+            if missing:
+                ck.f64(f"coupling.{missing[0]}")  # raises, naming the file and the array
+            try:
+                self.scheme.restore(lambda k: ck.f64(f"coupling.{k}"))
+            except ValueError as e:
+                raise CheckpointError(f"checkpoint `{path}`: {e}") from None
+        except CheckpointError as e:
+            raise CaseError(str(e)) from None
+        self.steps, self.t = ck.step, ck.time
 
     def _check(self, what, values, t, step, dt):
         for i, x in enumerate(values):
@@ -249,9 +296,14 @@ class SpringMass:
         return self.body.reduce(f)
 
     def init(self, peer):
-        peer.publish_topology(StepHeader(topology_version=1), self.body.elements)
-        self._publish(peer, 0, 0.0, 0.0, False)
-        self._write_probe()
+        """Publishes the topology and the state; a restarted solver publishes the checkpoint's
+        state and writes no probe row (its file holds that one)."""
+        step, t = self.steps, self.t
+        peer.publish_topology(StepHeader(step=step, time=t, topology_version=1),
+                              self.body.elements)
+        self._publish(peer, step, t, 0.0, False)
+        if step == 0:
+            self._write_probe()
         return self.body.dt_stable()
 
     def advance(self, peer, c):
@@ -279,17 +331,37 @@ class SpringMass:
             for what, x in [("displacement", d.u), ("velocity", d.v), ("acceleration", d.a)]:
                 self._check(what, x, c.t_to, c.step, dt)
             self.t = c.t_to
+            self.steps = c.step + 1
             if (c.step + 1) % self.body.probes_every == 0:
                 self._write_probe()
         else:
             raise Failure(fsi_peer.CODE_UNSUPPORTED, f"the structure has no Advance phase "
                                                      f"{c.scheme_phase} (expected START, "
                                                      "PREDICT or CORRECT)")
-        return c.step, self.t, self.body.dt_stable()
+        return c.step, self.t, self.body.dt_stable(), self.scheme.interface_work()
 
     def checkpoint(self, _peer, tag):
-        raise Failure(fsi_peer.CODE_UNSUPPORTED,
-                      f"{PROG} writes no checkpoints (asked for `{tag}`)")
+        """Writes `checkpoints/<tag>/structure.ckpt` (the module's docs); flushes the probes
+        first."""
+        if not tag or tag.startswith(".") or "/" in tag or "\\" in tag:
+            raise Failure(fsi_peer.CODE_PROTOCOL, f"checkpoint tag `{tag}` must be non-empty, "
+                                                  "not start with `.`, and contain no `/` or `\\`")
+        d = self.state
+        arrays = [("u", d.u), ("v", d.v), ("a", d.a), ("v_half", d.v_half)]
+        arrays += [(f"coupling.{k}", v) for k, v in self.scheme.history()]
+        folder = os.path.join(self.out, "checkpoints", tag)
+        try:
+            self.probes.flush()
+            os.makedirs(folder, exist_ok=True)
+        except OSError as e:
+            raise Failure(fsi_peer.CODE_OUTPUT, f"cannot write the checkpoint: {e.filename}: "
+                                                f"{e.strerror}") from None
+        try:
+            fsi_peer.write_checkpoint(os.path.join(folder, f"{PART}.{fsi_peer.CKPT_EXTENSION}"),
+                                      self.steps, self.t,
+                                      fsi_peer.postcard_strings(self.body.dofs), arrays)
+        except CheckpointError as e:
+            raise Failure(fsi_peer.CODE_OUTPUT, f"cannot write the checkpoint: {e}") from None
 
     def finish(self, _peer):
         try:
@@ -297,6 +369,53 @@ class SpringMass:
         except OSError as e:
             raise Failure(fsi_peer.CODE_OUTPUT,
                           f"cannot write structure_probes.csv: {e.strerror}") from None
+
+
+def restart_part(folder):
+    """The structure part `--restart folder` names, as `checkpoint::restart_point`: the folder's
+    own `structure.ckpt`, else the newest `checkpoints/<tag>/structure.ckpt` under it."""
+    name = f"{PART}.{fsi_peer.CKPT_EXTENSION}"
+    own = os.path.join(folder, name)
+    if os.path.isfile(own):
+        return own
+    checkpoints = os.path.join(folder, "checkpoints")
+    try:
+        tags = sorted(os.listdir(checkpoints), reverse=True)
+    except OSError:
+        tags = []
+    for tag in tags:
+        path = os.path.join(checkpoints, tag, name)
+        if os.path.isfile(path):
+            return path
+    raise CaseError(f"--restart {folder}: no structure checkpoint there (neither {own} nor "
+                    f"{checkpoints}/<tag>/{name})")
+
+
+def rows_until(path, header, t):
+    """The rows of the probe file `path` up to time `t` (`ProbeWriter::resume`): its header must
+    be `header`; rows a stopped run wrote past `t` are dropped."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().splitlines()
+    except OSError as e:
+        raise CaseError(f"cannot continue the probe file {path} at t = {t:e}: "
+                        f"{e.strerror}") from None
+    found = lines[0] if lines else ""
+    if found != header:
+        raise CaseError(f"cannot continue the probe file {path} at t = {t:e}: its header is "
+                        f"`{found}`, the case's probe gives `{header}`")
+    kept = []
+    for i, line in enumerate(lines[1:]):
+        time = line.split(",", 1)[0]
+        try:
+            value = float(time)
+        except ValueError:
+            raise CaseError(f"cannot continue the probe file {path} at t = {t:e}: line {i + 2}: "
+                            f"`{time}` is not a time") from None
+        if value > t:
+            break
+        kept.append(line + "\n")
+    return "".join(kept)
 
 
 def prepare(args):
@@ -312,11 +431,11 @@ def run(args):
     if not os.path.isdir(out):
         raise CaseError(f"the output folder {out} does not exist (the launcher makes it)")
     fsi_peer.install_signal_handlers()
-    solver = SpringMass(body, out)
+    solver = SpringMass(body, out, args.restart)
     peer = None
     try:
         peer = fsi_peer.StructurePeer(args.couple, len(body.wet_nodes), len(body.elements),
-                                      case_hash, body.timeout_s)
+                                      case_hash, body.timeout_s, CAPABILITIES)
         fsi_peer.serve(peer, solver)
     except fsi_peer.Stopped as e:
         raise CaseError(f"run {args.couple} stopped: {e}") from None
@@ -337,6 +456,7 @@ def main(argv):
             p.add_argument("--couple", metavar="RUN_ID")
             p.add_argument("--out", metavar="DIR")
             p.add_argument("--force", action="store_true")
+            p.add_argument("--restart", metavar="CKPT")
     args = parser.parse_args(argv)
     try:
         if args.command == "check":

@@ -96,9 +96,39 @@ class Oscillators:
         self.a = (self.v - v0) / dt
 
 
+class Ledger:
+    """The work of the applied load on the displacement (`coupling::Ledger`): a central-
+    difference substep from u^k to u^{k+1} with the loads F^k (the previous substep's, F^0 at
+    START) and F^{k+1} adds (F^k + F^{k+1})/2 · (u^{k+1} - u^k); an implicit midpoint step
+    with F held adds F · (u^{n+1} - u^n). Summed component by component in order, as Rust's
+    `Iterator::sum`."""
+
+    def __init__(self, n):
+        self.f_applied = np.zeros(n)
+        self.u_before = np.zeros(n)
+        self.work = 0.0
+
+    def begin(self, d):
+        self.u_before = d.u.copy()
+
+    def end(self, d, f, held):
+        after, before, applied = d.u, self.u_before, self.f_applied
+        total = 0.0
+        for i in range(len(f)):
+            load = f[i] if held else 0.5 * (applied[i] + f[i])
+            total += float(load * (after[i] - before[i]))
+        self.work += total
+        self.f_applied = np.array(f, dtype=np.float64)
+
+
+# The names of `Staggered.history`, in `coupling::Staggered::history`'s order.
+HISTORY = ["f_half", "v_half_prev", "a_hat", "f_prev", "times", "f_applied", "work"]
+
+
 class Staggered:
     """The scheme's state through START, PREDICT and CORRECT (`coupling::Staggered`), with
-    `m` central-difference substeps per coupling step for CSS and C0 (PROTOCOL §4)."""
+    `m` central-difference substeps per coupling step for CSS and C0 (PROTOCOL §4), and the
+    energy ledger (`interface_work`)."""
 
     def __init__(self, scheme, n, fixed_substeps=None):
         z = np.zeros(n)
@@ -112,6 +142,48 @@ class Staggered:
         self.stable_step = float("inf")
         self.fixed_substeps = fixed_substeps
         self.n_substeps = 1
+        self.ledger = Ledger(n)
+
+    def interface_work(self):
+        """The work of the applied loads on the displacement from t = 0 (`Ledger`)."""
+        return self.ledger.work
+
+    def history(self):
+        """What a checkpoint keeps, named as `coupling::Staggered::history`: C0's F^{n+1/2} and
+        v^{n-1/2}, A6's â^n, the load sample before, the times [t^n, t_prev, t_half], the
+        ledger's last applied load and its work."""
+        return [
+            ("f_half", self.f_half.copy()),
+            ("v_half_prev", self.v_half_prev.copy()),
+            ("a_hat", self.a_hat.copy()),
+            ("f_prev", self.f_prev.copy()),
+            ("times", np.array([self.t, self.t_prev, self.t_half])),
+            ("f_applied", self.ledger.f_applied.copy()),
+            ("work", np.array([self.ledger.work])),
+        ]
+
+    def restore(self, get):
+        """Puts back the `history` that `get(name)` returns (None: missing), after CORRECT of
+        the step the checkpoint closed; raises ValueError naming a missing or mis-sized entry."""
+        n = len(self.f_half)
+
+        def take(name, size):
+            v = get(name)
+            if v is None:
+                raise ValueError(f"coupling history `{name}` is missing")
+            v = np.array(v, dtype=np.float64)
+            if v.size != size:
+                raise ValueError(f"coupling history `{name}` holds {v.size} values, expected "
+                                 f"{size}")
+            return v
+
+        self.f_half = take("f_half", n)
+        self.v_half_prev = take("v_half_prev", n)
+        self.a_hat = take("a_hat", n)
+        self.f_prev = take("f_prev", n)
+        self.t, self.t_prev, self.t_half = (float(x) for x in take("times", 3))
+        self.ledger.f_applied = take("f_applied", n)
+        self.ledger.work = float(take("work", 1)[0])
 
     def substeps(self, dt):
         if self.scheme == "A6":
@@ -127,6 +199,7 @@ class Staggered:
         d.start(f0)
         self.a_hat = d.a.copy()
         self.f_prev = np.array(f0, dtype=np.float64)
+        self.ledger.f_applied = self.f_prev.copy()
         self.t_prev = self.t
         if self.scheme == "C0":
             self.v_half_prev = kick(d.v, d.a, -0.5 * dt)
@@ -160,13 +233,16 @@ class Staggered:
         self.n_substeps = m
         h = dt / m
         for k in range(1, m + 1):
+            self.ledger.begin(d)
             d.advance_positions(h)
             if 2 * k - 1 == m:
                 self.v_mid = d.v_half.copy()
             if k == m:
                 break
             tk = self.t + k * h
-            d.complete(load_line(self.t_prev, self.f_prev, self.t_half, self.f_half, tk), h)
+            f = load_line(self.t_prev, self.f_prev, self.t_half, self.f_half, tk)
+            d.complete(f, h)
+            self.ledger.end(d, f, False)
             if 2 * k == m:
                 self.v_mid = d.v.copy()
 
@@ -177,16 +253,23 @@ class Staggered:
             m = self.substeps(dt)
             h = dt / m
             for k in range(1, m + 1):
+                self.ledger.begin(d)
                 d.advance_positions(h)
-                d.complete(load_between(self.f_prev, load, k / m), h)
+                f = load_between(self.f_prev, load, k / m)
+                d.complete(f, h)
+                self.ledger.end(d, f, False)
             self.f_prev = load
         elif self.scheme == "C0":
-            d.complete(c0_load_average(self.f_half, load), dt / self.n_substeps)
+            f = c0_load_average(self.f_half, load)
+            d.complete(f, dt / self.n_substeps)
+            self.ledger.end(d, f, False)
             self.v_half_prev = self.v_mid.copy()
             self.f_prev, self.t_prev = self.f_half, self.t_half
             self.f_half, self.t_half = load, self.t + 1.5 * dt
         else:
             v_prev = d.v.copy()
+            self.ledger.begin(d)
             d.implicit_midpoint(load, dt)
+            self.ledger.end(d, load, True)
             self.a_hat = a6_acceleration_estimate(d.v, v_prev, dt)
         self.t += dt

@@ -30,18 +30,11 @@ fn bin(name: &str) -> PathBuf {
     p
 }
 
-/// The plate case: 0.2 m square steel plate, 5 mm, 4 x 4 MITC4, clamped edges, water column.
+/// The clamped plate (`clamped_plate.toml`, shared with `tests/tests/coupled_restart.rs`).
+const PLATE: &str = include_str!("clamped_plate.toml");
+
+/// The plate case: the clamped plate under a water column.
 fn case(scheme: &str, dt: f64) -> String {
-    let edge = |name: &str, min: [f64; 3], max: [f64; 3]| {
-        format!("{name} = {{ min = {min:?}, max = {max:?} }}\n")
-    };
-    let bc = |set: &str| {
-        format!(
-            "[[structure.bc]]\nset = \"{set}\"\nfixed = [\"ux\", \"uy\", \"uz\", \"rx\", \"ry\", \"rz\"]\n"
-        )
-    };
-    let (a, b) = (-1e-9, 1e-9);
-    let (c, d) = (0.2 - 1e-9, 0.2 + 1e-9);
     format!(
         r#"[case]
 name = "plate"
@@ -58,26 +51,7 @@ p0 = 1e4
 rho0 = 1000.0
 c0 = 1500.0
 normal = [0.0, 0.0, 1.0]
-[structure]
-command = ["structure-solver"]
-mesh = {{ generator = "rectangle", lx = 0.2, ly = 0.2, nx = 4, ny = 4 }}
-material = {{ e = 200e9, nu = 0.3, rho = 7800.0 }}
-thickness = 0.005
-element = "mitc4"
-wet_set = "all"
-[[structure.probes]]
-name = "centre"
-point = [0.1, 0.1, 0.0]
-[structure.sets]
-{}{}{}{}{}{}{}{}"#,
-        edge("x0", [a, -1.0, -1.0], [b, 1.0, 1.0]),
-        edge("x1", [c, -1.0, -1.0], [d, 1.0, 1.0]),
-        edge("y0", [-1.0, a, -1.0], [1.0, b, 1.0]),
-        edge("y1", [-1.0, c, -1.0], [1.0, d, 1.0]),
-        bc("x0"),
-        bc("x1"),
-        bc("y0"),
-        bc("y1"),
+{PLATE}"#
     )
 }
 

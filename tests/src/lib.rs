@@ -7,6 +7,7 @@
 //! structure-solver -p fsi-system-tests --bins && cargo test --release -p fsi-system-tests`.
 
 pub mod order;
+pub mod restart;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
