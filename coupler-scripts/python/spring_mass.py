@@ -12,7 +12,7 @@ wet_elements, probe), steps the body with the staggered scheme of `[coupling]` (
 `structure_probes.csv` as `rigid-structure` does.
 
 At `Checkpoint { tag }` it writes `OUT/checkpoints/<tag>/structure.ckpt` atomically, in the
-project's checkpoint format (`fsi_peer.write_checkpoint`, that of `interface_protocol::io::
+project's checkpoint format (`checkpoint.write_checkpoint`, that of `interface_protocol::io::
 checkpoint`) and with the content of `rigid-structure`'s part: the step and time of the header,
 the DOF names as metadata (a postcard `Vec<String>`), the f64 arrays `u`, `v`, `a`, `v_half` (one
 value per DOF) and `coupling.<name>` for each entry of the scheme's history (`staggered.HISTORY`:
@@ -33,7 +33,9 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import fsi_peer  # noqa: E402
-from fsi_peer import CheckpointError, Failure, StepHeader, SurfaceElement  # noqa: E402
+import checkpoint  # noqa: E402
+from checkpoint import CheckpointError  # noqa: E402
+from fsi_peer import Failure, StepHeader, SurfaceElement  # noqa: E402
 from staggered import HISTORY, Oscillators, Staggered  # noqa: E402
 
 PROG = "spring_mass"
@@ -230,9 +232,9 @@ class SpringMass:
         """Puts back the state, the scheme's history, the step and the time of the part `path`
         (written by `checkpoint`); the error names the file and the array that does not fit."""
         try:
-            ck = fsi_peer.read_checkpoint(path)
+            ck = checkpoint.read_checkpoint(path)
             try:
-                names = fsi_peer.postcard_strings_decode(ck.meta)
+                names = checkpoint.postcard_strings_decode(ck.meta)
             except (ValueError, UnicodeDecodeError) as e:
                 raise CheckpointError(f"checkpoint `{path}`: metadata: {e} (expected the DOF "
                                       "names)") from None
@@ -357,9 +359,9 @@ class SpringMass:
             raise Failure(fsi_peer.CODE_OUTPUT, f"cannot write the checkpoint: {e.filename}: "
                                                 f"{e.strerror}") from None
         try:
-            fsi_peer.write_checkpoint(os.path.join(folder, f"{PART}.{fsi_peer.CKPT_EXTENSION}"),
-                                      self.steps, self.t,
-                                      fsi_peer.postcard_strings(self.body.dofs), arrays)
+            checkpoint.write_checkpoint(os.path.join(folder, f"{PART}.{checkpoint.CKPT_EXTENSION}"),
+                                        self.steps, self.t,
+                                        checkpoint.postcard_strings(self.body.dofs), arrays)
         except CheckpointError as e:
             raise Failure(fsi_peer.CODE_OUTPUT, f"cannot write the checkpoint: {e}") from None
 
@@ -374,7 +376,7 @@ class SpringMass:
 def restart_part(folder):
     """The structure part `--restart folder` names, as `checkpoint::restart_point`: the folder's
     own `structure.ckpt`, else the newest `checkpoints/<tag>/structure.ckpt` under it."""
-    name = f"{PART}.{fsi_peer.CKPT_EXTENSION}"
+    name = f"{PART}.{checkpoint.CKPT_EXTENSION}"
     own = os.path.join(folder, name)
     if os.path.isfile(own):
         return own
