@@ -8,15 +8,16 @@
 //!   peaks of this run and the README's fine peak within [1.5, 2.5] (measured 1.95), and the
 //!   Richardson value from them within 3% of the README's 0.2985 mm (a change of the coarse or
 //!   medium peak by 2% moves the order by about 0.1 and the extrapolation by about 1%);
-//! - the first pressure pulse reaches `below` (2 cm from the bubble's surface, on the far side
-//!   from the plate) at the speed of sound of the water: the half-peak crossing within 10% of
-//!   d/c on both meshes (measured -5.3% and -2.8%, the front smeared over two cells); `sensor`
-//!   (1 cm from the surface, towards the plate) within 10% on the coarse mesh (measured +5.4%;
-//!   it comes later on finer meshes, see the README);
-//! - the pulse's peak at `below` (3 R0 from the centre) against the acoustic 1/r estimate from
-//!   the planar two-phase Riemann problem, (p* - p_inf) R0 / r = 2.978 MPa: within 25% on the
-//!   coarse mesh and 10% on the medium one (measured -22% and -7.2%), and growing with
-//!   refinement;
+//! - the first pressure pulse reaches the probes at the speed of sound of the water: the
+//!   half-peak crossing within 8% of d/c at `oblique` (between the bubble and the plate, off the
+//!   axis, 12.4 mm from the bubble's surface) and `below` (2 cm from the surface, on the far
+//!   side) on both meshes (measured -4.4%, -2.8% and -5.3%, -2.8%: the front smeared over about
+//!   two cells), and at `sensor` (on the axis towards the plate) within 10% on the coarse mesh
+//!   (measured +5.4%; later on finer grids, a grid effect on the axis, see the README);
+//! - the pulse's peak against the acoustic 1/r estimate from the planar two-phase Riemann
+//!   problem, (p* - p_inf) R0 / r, p* = 9.9355 MPa: at `oblique` (3.996 MPa) within 15% on the
+//!   coarse mesh and 5% on the medium one (measured -9.7% and +0.5%), at `below` (2.978 MPa)
+//!   within 25% and 10% (measured -22% and -7.2%), growing with refinement at `below`;
 //! - the interface energy ledger closes within 1% on both (measured 0.13% and 0.12%).
 //!
 //! Build first: `cargo build --release -p coupler-scripts -p structure-solver -p fluid-solver --bins`.
@@ -33,8 +34,10 @@ const P_INF: f64 = 1e6;
 const FINE_PEAK: f64 = 2.73549e-4;
 /// The Richardson value of the three meshes (README).
 const RICHARDSON_PEAK: f64 = 2.9853e-4;
-/// (p* - p_inf) R0 / r at r = 3 R0, p* = 9.9355 MPa of the planar gas | water Riemann problem.
+/// (p* - p_inf) R0 / r, p* = 9.9355 MPa of the planar gas | water Riemann problem: at `below`
+/// (r = 3 R0) and at `oblique` (r = sqrt(5) R0).
 const ACOUSTIC_BELOW: f64 = 2.978e6;
+const ACOUSTIC_OBLIQUE: f64 = 3.996e6;
 
 fn case_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/bubble-plate")
@@ -53,6 +56,7 @@ fn pulse(series: &[(f64, f64)], until: f64) -> (f64, f64) {
 struct Mesh {
     peak: f64,
     below_peak: f64,
+    oblique_peak: f64,
 }
 
 /// Checks one finished run and returns its numbers.
@@ -68,8 +72,10 @@ fn check(out: &Path, label: &str, check_sensor: bool) -> Mesh {
     assert!(centre.last().unwrap().1 < 0.97 * peak, "{label}: no peak before the end");
 
     let probes = Probes::read(&out.join("probes.csv"));
-    let mut below_peak = 0.0;
-    for (name, d) in [("sensor", 0.01), ("below", 0.02)] {
+    let (mut below_peak, mut oblique_peak) = (0.0, 0.0);
+    let oblique = 0.02f64.hypot(0.01) - 0.01;
+    for (name, d, tol) in [("sensor", 0.01, 0.1), ("below", 0.02, 0.08), ("oblique", oblique, 0.08)]
+    {
         let series = probes.series(&format!("{name}.p"));
         assert!(series.iter().all(|&(_, p)| p.is_finite() && p > 0.0), "{label} {name}: bad p");
         // Before the pulse reflected at the plate is back at `sensor` (19.7 µs).
@@ -82,14 +88,16 @@ fn check(out: &Path, label: &str, check_sensor: bool) -> Mesh {
             expected * 1e6,
             (t_half / expected - 1.0) * 100.0
         );
-        if name == "below" || check_sensor {
+        if name != "sensor" || check_sensor {
             assert!(
-                (t_half - expected).abs() <= 0.1 * expected,
+                (t_half - expected).abs() <= tol * expected,
                 "{label} {name}: pulse at {t_half:e} s, d/c = {expected:e} s"
             );
         }
-        if name == "below" {
-            below_peak = dp;
+        match name {
+            "below" => below_peak = dp,
+            "oblique" => oblique_peak = dp,
+            _ => {}
         }
     }
 
@@ -102,7 +110,7 @@ fn check(out: &Path, label: &str, check_sensor: bool) -> Mesh {
         report["coupling_overhead"]
     );
     assert!(relative.abs() < 1e-2, "{label}: interface energy {energy}");
-    Mesh { peak, below_peak }
+    Mesh { peak, below_peak, oblique_peak }
 }
 
 #[test]
@@ -136,11 +144,18 @@ fn the_bubble_bends_the_plate_away_converging_and_its_pulse_arrives_at_the_speed
         "Richardson peak {richardson:e} m, README {RICHARDSON_PEAK:e} m"
     );
 
-    for (label, mesh, tol) in [("coarse", &coarse, 0.25), ("medium", &medium, 0.1)] {
+    for (label, mesh, tol_below, tol_oblique) in
+        [("coarse", &coarse, 0.25, 0.15), ("medium", &medium, 0.1, 0.05)]
+    {
         assert!(
-            (mesh.below_peak - ACOUSTIC_BELOW).abs() <= tol * ACOUSTIC_BELOW,
-            "{label}: pulse peak at 3 R0 {} Pa, acoustic {ACOUSTIC_BELOW} Pa",
+            (mesh.below_peak - ACOUSTIC_BELOW).abs() <= tol_below * ACOUSTIC_BELOW,
+            "{label}: pulse peak at `below` {} Pa, acoustic {ACOUSTIC_BELOW} Pa",
             mesh.below_peak
+        );
+        assert!(
+            (mesh.oblique_peak - ACOUSTIC_OBLIQUE).abs() <= tol_oblique * ACOUSTIC_OBLIQUE,
+            "{label}: pulse peak at `oblique` {} Pa, acoustic {ACOUSTIC_OBLIQUE} Pa",
+            mesh.oblique_peak
         );
     }
     assert!(
