@@ -10,7 +10,11 @@ Quadrilateral node order gives the normal +z (away from the bubble). Units: metr
 
 Run: python3 cases/bubble-plate/make_mesh.py [N] > cases/bubble-plate/plate.msh
 """
+import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../../scripts"))
+from gmsh_quads import write_quads  # noqa: E402
 
 Z, A = 1e-3, 40.5e-3
 D = A / 1000.0
@@ -25,16 +29,4 @@ def node(i, j):
 
 quads = [(node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)) for j in range(n) for i in range(n)]
 
-print("$MeshFormat\n4.1 0 8\n$EndMeshFormat")
-print('$PhysicalNames\n1\n2 1 "plate"\n$EndPhysicalNames')
-print(f"$Entities\n0 0 1 0\n1 {-D} {-D} {Z} {A} {A} {Z} 1 1 0\n$EndEntities")
-print(f"$Nodes\n1 {len(nodes)} 1 {len(nodes)}\n2 1 0 {len(nodes)}")
-for i in range(len(nodes)):
-    print(i + 1)
-for x, y, z in nodes:
-    print(f"{x!r} {y!r} {z!r}")
-print("$EndNodes")
-print(f"$Elements\n1 {len(quads)} 1 {len(quads)}\n2 1 3 {len(quads)}")
-for e, q in enumerate(quads):
-    print(e + 1, *q)
-print("$EndElements")
+write_quads("plate", nodes, quads)

@@ -11,7 +11,11 @@ Quadrilateral node order gives the normal +x (downstream). Units: metres.
 
 Run: python3 cases/shock-panel/make_mesh.py [N_ALONG] > cases/shock-panel/panel.msh
 """
+import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../../scripts"))
+from gmsh_quads import write_quads  # noqa: E402
 
 X, Y0, TIP, HALF = 0.5e-3, -2e-3, 50e-3, 0.8008e-3
 n = int(sys.argv[1]) if len(sys.argv) > 1 else 26  # elements along y (2 mm each by default)
@@ -19,16 +23,4 @@ ys = [Y0 + (TIP - Y0) * k / n for k in range(n + 1)]
 nodes = [(X, y, z) for y in ys for z in (-HALF, HALF)]
 quads = [(2 * k + 1, 2 * k + 3, 2 * k + 4, 2 * k + 2) for k in range(n)]
 
-print("$MeshFormat\n4.1 0 8\n$EndMeshFormat")
-print('$PhysicalNames\n1\n2 1 "panel"\n$EndPhysicalNames')
-print(f"$Entities\n0 0 1 0\n1 {X} {Y0} {-HALF} {X} {TIP} {HALF} 1 1 0\n$EndEntities")
-print(f"$Nodes\n1 {len(nodes)} 1 {len(nodes)}\n2 1 0 {len(nodes)}")
-for i in range(len(nodes)):
-    print(i + 1)
-for x, y, z in nodes:
-    print(f"{x!r} {y!r} {z!r}")
-print("$EndNodes")
-print(f"$Elements\n1 {len(quads)} 1 {len(quads)}\n2 1 3 {len(quads)}")
-for e, q in enumerate(quads):
-    print(e + 1, *q)
-print("$EndElements")
+write_quads("panel", nodes, quads)
