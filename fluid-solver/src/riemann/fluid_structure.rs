@@ -5,7 +5,8 @@
 //! One wave leaves the wall: a shock if `u_n > w_n` (the wall pushes), a rarefaction otherwise;
 //! the star state has `u* = w_n`, so `f(p*) = u_n - w_n` with the same wave curve `f` as the
 //! two-sided problem (App. A mirrors the state about the wall: a symmetric Riemann problem whose
-//! star velocity is zero in the wall frame).
+//! star velocity is zero in the wall frame). That root has a closed form for every rarefaction
+//! and for a gas shock (`Side::root`); only a Tait shock is solved by Newton's method.
 
 use super::wave_curve::Side;
 use super::{solve_increasing, Clipped, PressureCutoff, RiemannError};
@@ -52,14 +53,18 @@ pub fn fluid_structure_with_cutoff(
             return Ok(Clipped { state, clipped: true });
         }
     }
-    let guess = p + rho * side.c * rel;
-    let p_star = solve_increasing(
-        |q| {
-            let (f, df) = side.f(q);
-            (f - rel, df)
-        },
-        side.p_floor(),
-        guess,
-    )?;
+    // A non-finite input leaves no finite root: Newton's method then reports it.
+    let p_star = match side.root(rel) {
+        Some(Ok(root)) if root.is_finite() => root,
+        Some(Err(e)) => return Err(e),
+        _ => solve_increasing(
+            |q| {
+                let (f, df) = side.f(q);
+                (f - rel, df)
+            },
+            side.p_floor(),
+            p + rho * side.c * rel,
+        )?,
+    };
     Ok(Clipped { state: WallState { rho: side.density_behind(p_star), p: p_star }, clipped: false })
 }

@@ -471,3 +471,42 @@ proptest! {
         }
     }
 }
+
+/// The closed-form root of the one-sided problem (`Side::root`: rarefactions of every EOS, gas
+/// shocks) is Newton's root of `f(p*) = u_n - w_n` to round-off, from strong rarefactions near the
+/// escape speed to strong shocks, on air, stiffened water and Tait water (rarefactions).
+#[test]
+fn closed_form_wall_root_is_newtons() {
+    let cases: [(Eos, f64, f64); 3] =
+        [(AIR, 1.2, 1e5), (WATER_SG, 1000.0, 1e5), (tait_water(), 1000.0, 1e5)];
+    let mut worst: f64 = 0.0;
+    for (eos, rho, p) in cases {
+        let side = wave_curve::Side::new(&eos, rho, 0.0, p);
+        let escape = 2.0 * side.c / (eos.stiffness().0 - 1.0);
+        for k in -99..=200 {
+            // From 0.99 of the escape speed (receding) to twice the sound speed (approaching).
+            let du = if k < 0 { 0.01 * k as f64 * escape } else { 0.01 * k as f64 * side.c };
+            let Some(root) = side.root(du) else {
+                assert!(eos.is_barotropic() && du > 0.0, "{eos:?}: no closed form for {du}");
+                continue;
+            };
+            let root = root.unwrap();
+            let newton = solve_increasing(
+                |q| {
+                    let (f, df) = side.f(q);
+                    (f - du, df)
+                },
+                side.p_floor(),
+                p + rho * side.c * du,
+            )
+            .unwrap();
+            let scale = newton + side.pi;
+            worst = worst.max((root - newton).abs() / scale);
+            assert!((root - newton).abs() <= 1e-13 * scale, "{eos:?}, du {du}: {root} vs {newton}");
+        }
+        // Past the escape speed: the same vacuum as Newton's.
+        let beyond = side.root(-1.01 * escape).unwrap();
+        assert!(matches!(beyond, Err(RiemannError::Vacuum { gap, .. }) if gap > 0.0), "{beyond:?}");
+    }
+    println!("closed-form wall root against Newton: largest difference {worst:e} of p̂*");
+}

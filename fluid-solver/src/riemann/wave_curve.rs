@@ -68,6 +68,38 @@ impl Side {
         }
     }
 
+    /// The pressure `p*` of `f_K(p*) = du` in closed form where there is one, the one-sided
+    /// (wall) problem's root: along the rarefaction (`du < 0`, every EOS),
+    /// `p̂* = p̂_K (1 + (g-1) du/(2c))^(2g/(g-1))` (as `p_K + p̂_K expm1(..)` when weak), a vacuum
+    /// when the base is not positive (`du <= -2c/(g-1)`, the escape speed); across a gas shock
+    /// (`du > 0`), the positive root of Toro's Eq. 4.21 squared, the quadratic
+    /// `A Δp² - du² Δp - du² (p̂_K + B) = 0`. `None` for a Tait shock, whose root is Newton's.
+    #[inline]
+    pub(super) fn root(&self, du: f64) -> Option<Result<f64, super::RiemannError>> {
+        let g = self.g;
+        let ph_k = self.p + self.pi;
+        if du <= 0.0 {
+            let base = (g - 1.0) / (2.0 * self.c) * du;
+            if base <= -1.0 {
+                let gap = -2.0 * self.c / (g - 1.0) - du;
+                return Some(Err(super::RiemannError::Vacuum { p_floor: self.p_floor(), gap }));
+            }
+            // Weak: p_K + p̂_K expm1(..) keeps the digits of p* - p_K; strong: p̂* itself.
+            let ln_ratio = 2.0 * g / (g - 1.0) * base.ln_1p();
+            Some(Ok(if ln_ratio > -0.5 {
+                self.p + ph_k * ln_ratio.exp_m1()
+            } else {
+                ph_k * ln_ratio.exp() - self.pi
+            }))
+        } else if self.barotropic {
+            None
+        } else {
+            let a = 2.0 / ((g + 1.0) * self.rho);
+            let b = (g - 1.0) / (g + 1.0) * ph_k;
+            Some(Ok(self.p + du * (du + (du * du + 4.0 * a * (ph_k + b)).sqrt()) / (2.0 * a)))
+        }
+    }
+
     /// Density behind the wave that takes `p_K` to `p`.
     #[inline]
     pub(super) fn density_behind(&self, p: f64) -> f64 {
