@@ -16,33 +16,43 @@
 //! triangles recorded for `i` hold every triangle whose box meets it, and the pass tests those
 //! instead of querying the tree from its root. An edge takes the triangles of its end with fewer
 //! (none when one end is not near: its reach box, which holds the edge, meets no triangle box).
+//!
+//! Each recorded pair also keeps which halves of the reach box, split at the node along each
+//! axis, the triangle box reaches ([`halves`]). A query box on one side of the node along an
+//! axis (an edge leaving the node upwards in x, say) needs a triangle box reaching that half, so
+//! a pass first tests those six bits and then the box itself: the same triangles, from a scan
+//! that skips most of the list without reading the triangle boxes.
 
 use super::OCCLUSION;
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
 
-/// Longest recorded triangle list searched as a list (a longer one is searched by the tree).
-pub const LIST_MAX: usize = 24;
+/// Nodes per parallel task of the list passes.
+const CHUNK: usize = 4096;
 
 /// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeBoxes {
     pub(super) tree: Bvh,
+    /// The largest occlusion radius of a node: the halves of each reach box overlap by it.
+    pub(super) rho: f64,
 }
 
 impl NodeBoxes {
     pub fn build(mesh: &Mesh, adjacency: &NodeEdges) -> NodeBoxes {
         let n = mesh.n_nodes();
         let (mut lo, mut hi) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut rho = 0.0f64;
         for i in 0..n {
             let (l, h) = adjacency.node_box(mesh, i);
             let r = OCCLUSION * adjacency.h_min[i];
             let r = if r.is_finite() { r } else { 0.0 };
+            rho = rho.max(r);
             lo.push(l.map(|v| v - r));
             hi.push(h.map(|v| v + r));
         }
-        NodeBoxes { tree: Bvh::over_boxes(lo, hi) }
+        NodeBoxes { tree: Bvh::over_boxes(lo, hi), rho }
     }
 
     /// Number of nodes.
@@ -60,10 +70,35 @@ impl NodeBoxes {
     }
 }
 
+/// The halves of a reach box, split at the node's position `p` along each axis and widened by
+/// `rho`, that the box `[lo, hi]` reaches: bit `2d` the lower (`lo[d] <= p[d] + rho`), bit
+/// `2d + 1` the upper (`hi[d] >= p[d] - rho`).
+#[inline]
+pub(super) fn halves(p: &[f64; 3], rho: f64, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
+    let mut bits = 0;
+    for d in 0..3 {
+        bits |= u8::from(lo[d] <= p[d] + rho) << (2 * d);
+        bits |= u8::from(hi[d] >= p[d] - rho) << (2 * d + 1);
+    }
+    bits
+}
+
+/// The halves ([`halves`]) every box overlapping `[lo, hi]` reaches: the lower along `d` when
+/// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho`.
+#[inline]
+fn needed(p: &[f64; 3], rho: f64, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
+    let mut bits = 0;
+    for d in 0..3 {
+        bits |= u8::from(hi[d] <= p[d] + rho) << (2 * d);
+        bits |= u8::from(lo[d] >= p[d] - rho) << (2 * d + 1);
+    }
+    bits
+}
+
 /// Mesh nodes and edges, each list ascending: the nodes whose reach box meets a triangle box and
 /// every edge touching one of them; with, from [`Near::find`], the triangles whose box meets each
-/// node's reach box.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// node's reach box and the halves of it each reaches.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Near {
     pub nodes: Vec<u32>,
     pub edges: Vec<u32>,
@@ -71,7 +106,14 @@ pub struct Near {
     /// entry per mesh node and one more); empty for the full passes of [`Near::all`].
     offsets: Vec<u32>,
     triangles: Vec<u32>,
+    /// Per recorded triangle, the halves of the node's reach box its box reaches ([`halves`]).
+    halves: Vec<u8>,
+    /// The widening of the halves ([`NodeBoxes::rho`]).
+    rho: f64,
 }
+
+/// Triangle lists of a run of nodes: per node its count, then the triangles and their halves.
+pub(super) type Lists = (Vec<u32>, Vec<u32>, Vec<u8>);
 
 impl Near {
     /// Every node and edge (the full passes), queried from the root of the hierarchy.
@@ -81,6 +123,8 @@ impl Near {
             edges: (0..mesh.n_edges() as u32).collect(),
             offsets: Vec::new(),
             triangles: Vec::new(),
+            halves: Vec::new(),
+            rho: 0.0,
         }
     }
 
@@ -91,17 +135,44 @@ impl Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
         let (offsets, triangles) =
             group_by_node(mesh.n_nodes(), &boxes.tree.overlapping_pairs(bvh));
-        Near::from_lists(mesh, adjacency, offsets, triangles)
+        let rho = boxes.rho;
+        let chunks: Vec<Lists> = par_node_chunks(mesh.n_nodes(), |range| {
+            let mut lists: Lists = Default::default();
+            for i in range {
+                let tris = &triangles[offsets[i] as usize..offsets[i + 1] as usize];
+                lists.0.push(tris.len() as u32);
+                lists.1.extend_from_slice(tris);
+                lists.2.extend(tris.iter().map(|&t| {
+                    let (lo, hi) = bvh.triangle_box(t as usize);
+                    halves(&mesh.coords[i], rho, &lo, &hi)
+                }));
+            }
+            lists
+        });
+        Near::from_lists(mesh, adjacency, rho, chunks)
     }
 
-    /// The near part from the triangle lists of every node (CSR, each list ascending): the nodes
-    /// with a non-empty list and their edges.
+    /// The near part from the triangle lists of every node, by runs of nodes in node order (each
+    /// list ascending): the nodes with a non-empty list and their edges.
     pub(super) fn from_lists(
         mesh: &Mesh,
         adjacency: &NodeEdges,
-        offsets: Vec<u32>,
-        triangles: Vec<u32>,
+        rho: f64,
+        chunks: Vec<Lists>,
     ) -> Near {
+        let mut offsets = Vec::with_capacity(mesh.n_nodes() + 1);
+        offsets.push(0u32);
+        let total = chunks.iter().map(|c| c.1.len()).sum();
+        let (mut triangles, mut all_halves) =
+            (Vec::with_capacity(total), Vec::with_capacity(total));
+        for (counts, tris, h) in chunks {
+            for c in counts {
+                offsets.push(offsets[offsets.len() - 1] + c);
+            }
+            triangles.extend_from_slice(&tris);
+            all_halves.extend_from_slice(&h);
+        }
+        debug_assert_eq!(offsets.len(), mesh.n_nodes() + 1, "one list per node");
         let nodes: Vec<u32> = (0..mesh.n_nodes() as u32)
             .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
             .collect();
@@ -120,7 +191,7 @@ impl Near {
                 word &= word - 1;
             }
         }
-        Near { nodes, edges, offsets, triangles }
+        Near { nodes, edges, offsets, triangles, halves: all_halves, rho }
     }
 
     /// The triangles whose box meets the reach box of node `i`, if recorded ([`Near::find`]).
@@ -131,30 +202,33 @@ impl Near {
     }
 
     /// Calls `visit` with every triangle of `bvh` whose box overlaps `[lo, hi]`, a box inside the
-    /// reach box of node `i` (the node's edges, its occlusion ball, its projection box): from the
-    /// triangles recorded for `i` when there are at most [`LIST_MAX`], else by a query from the
-    /// root (which prunes a long list faster). The same
-    /// triangles either way (a triangle box meeting `[lo, hi]` meets the reach box), in another
-    /// order. `bvh` must be the hierarchy `find` was given, unchanged since.
+    /// reach box of node `i` at `p` (the node's edges, its occlusion ball, its projection box):
+    /// from the triangles recorded for `i` that reach the halves the box needs ([`halves`]), else
+    /// (none recorded, [`Near::all`]) by a query from the root. The same triangles either way (a
+    /// triangle box meeting `[lo, hi]` meets the reach box), in another order. `bvh` must be the
+    /// hierarchy `find` was given, unchanged since.
     #[inline]
     pub fn for_each_overlap(
         &self,
         bvh: &Bvh,
         i: usize,
+        p: &[f64; 3],
         lo: &[f64; 3],
         hi: &[f64; 3],
         mut visit: impl FnMut(u32),
     ) {
-        match self.triangles_of(i) {
-            Some(tris) if tris.len() <= LIST_MAX => {
-                for &t in tris {
-                    let (a, b) = bvh.triangle_box(t as usize);
-                    if overlaps(&a, &b, lo, hi) {
-                        visit(t);
-                    }
+        let (Some(&a), Some(&b)) = (self.offsets.get(i), self.offsets.get(i + 1)) else {
+            return bvh.for_each_overlap(lo, hi, visit);
+        };
+        let (a, b) = (a as usize, b as usize);
+        let need = needed(p, self.rho, lo, hi);
+        for (&t, &h) in self.triangles[a..b].iter().zip(&self.halves[a..b]) {
+            if h & need == need {
+                let (tlo, thi) = bvh.triangle_box(t as usize);
+                if overlaps(&tlo, &thi, lo, hi) {
+                    visit(t);
                 }
             }
-            _ => bvh.for_each_overlap(lo, hi, visit),
         }
     }
 
@@ -167,6 +241,15 @@ impl Near {
             _ => i,
         }
     }
+}
+
+/// `run` over the nodes `0..n` by runs of [`CHUNK`], in parallel, the results in node order.
+pub(super) fn par_node_chunks<T: Send>(
+    n: usize,
+    run: impl Fn(std::ops::Range<usize>) -> T + Sync,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| run(c * CHUNK..n.min((c + 1) * CHUNK))).collect()
 }
 
 /// Pairs `[node, triangle]` (each once) grouped by node, by counting: the offsets (one per node
@@ -238,6 +321,55 @@ mod tests {
         edges.sort_unstable();
         edges.dedup();
         assert_eq!(near.edges, edges, "{label}");
+    }
+
+    /// The scan of a node's recorded triangles, filtered by the halves, visits exactly the
+    /// triangles whose box meets the query box, for the boxes the passes ask (each edge of the
+    /// node, the node itself, its occlusion ball, its node box) and for boxes on a node plane.
+    #[test]
+    fn the_halves_skip_only_triangles_whose_box_misses_the_query() {
+        let mesh = cube_mesh(10, 0.3, 9);
+        let adj = NodeEdges::build(&mesh);
+        let boxes = NodeBoxes::build(&mesh, &adj);
+        let flat = box_surface([0.2, 0.3, 0.4], [0.8, 0.7, 0.4 + 1e-9], 3);
+        let mut queries = 0;
+        for s in [sphere([0.52, 0.47, 0.5], 0.3, 6), flat, plane(-0.5, 1.5, -0.5, 1.5, 0.5)] {
+            let bvh = Bvh::build(&s, 1e-9);
+            let near = Near::find(&mesh, &adj, &boxes, &bvh);
+            for &i in &near.nodes {
+                let i = i as usize;
+                let p = mesh.coords[i];
+                let r = OCCLUSION * adj.h_min[i];
+                let mut asks = vec![(p, p), (p.map(|v| v - r), p.map(|v| v + r))];
+                asks.push(adj.node_box(&mesh, i));
+                for (j, _) in adj.neighbours(&mesh, i) {
+                    let q = mesh.coords[j];
+                    asks.push((
+                        [0, 1, 2].map(|d| p[d].min(q[d])),
+                        [0, 1, 2].map(|d| p[d].max(q[d])),
+                    ));
+                    let mut flat_q = q;
+                    flat_q[1] = p[1];
+                    asks.push((
+                        [0, 1, 2].map(|d| p[d].min(flat_q[d])),
+                        [0, 1, 2].map(|d| p[d].max(flat_q[d])),
+                    ));
+                }
+                for (lo, hi) in asks {
+                    let mut got = Vec::new();
+                    near.for_each_overlap(&bvh, i, &p, &lo, &hi, |t| got.push(t));
+                    let want: Vec<u32> = (0..bvh.len() as u32)
+                        .filter(|&t| {
+                            let (a, b) = bvh.triangle_box(t as usize);
+                            overlaps(&a, &b, &lo, &hi)
+                        })
+                        .collect();
+                    assert_eq!(got, want, "node {i}");
+                    queries += usize::from(!want.is_empty());
+                }
+            }
+        }
+        assert!(queries > 1000, "{queries}");
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! hierarchy size triggers the next rebuild. Nothing here is state of the run: a restarted run
 //! rebuilds at its first step and gets the same [`Near`].
 
-use super::near::{group_by_node, Near, NodeBoxes};
+use super::near::{group_by_node, halves, par_node_chunks, Lists, Near, NodeBoxes};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
@@ -84,22 +84,27 @@ impl NearSkin {
         if !self.holds(bvh) {
             self.rebuild(boxes, bvh);
         }
-        let n = mesh.n_nodes();
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut triangles = Vec::new();
-        offsets.push(0u32);
-        for i in 0..n {
-            let kept = &self.kept[self.offsets[i] as usize..self.offsets[i + 1] as usize];
-            if !kept.is_empty() {
-                let (lo, hi) = boxes.tree.triangle_box(i);
-                triangles.extend(kept.iter().copied().filter(|&t| {
-                    let (a, b) = bvh.triangle_box(t as usize);
-                    overlaps(&lo, &hi, &a, &b)
-                }));
+        let rho = boxes.rho;
+        let chunks: Vec<Lists> = par_node_chunks(mesh.n_nodes(), |range| {
+            let mut lists: Lists = Default::default();
+            for i in range {
+                let kept = &self.kept[self.offsets[i] as usize..self.offsets[i + 1] as usize];
+                let before = lists.1.len();
+                if !kept.is_empty() {
+                    let (lo, hi) = boxes.tree.triangle_box(i);
+                    for &t in kept {
+                        let (a, b) = bvh.triangle_box(t as usize);
+                        if overlaps(&lo, &hi, &a, &b) {
+                            lists.1.push(t);
+                            lists.2.push(halves(&mesh.coords[i], rho, &a, &b));
+                        }
+                    }
+                }
+                lists.0.push((lists.1.len() - before) as u32);
             }
-            offsets.push(triangles.len() as u32);
-        }
-        Near::from_lists(mesh, adjacency, offsets, triangles)
+            lists
+        });
+        Near::from_lists(mesh, adjacency, rho, chunks)
     }
 
     /// Memory in bytes.
