@@ -22,8 +22,6 @@
 use super::closest::Nearest;
 use super::{Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
-#[cfg(test)]
-use crate::embedded::predicates::Closest;
 use crate::embedded::predicates::{closest_point, unit_normal, Feature};
 use crate::embedded::CutEdge;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
