@@ -112,8 +112,39 @@ pub struct Near {
     rho: f64,
 }
 
-/// Triangle lists of a run of nodes: per node its count, then the triangles and their halves.
-pub(super) type Lists = (Vec<u32>, Vec<u32>, Vec<u8>);
+/// The triangle lists of a run of nodes: the nodes with a non-empty list (ascending), the length
+/// of each, the triangles and their halves.
+#[derive(Debug, Default)]
+pub(super) struct Lists {
+    nodes: Vec<u32>,
+    counts: Vec<u32>,
+    triangles: Vec<u32>,
+    halves: Vec<u8>,
+}
+
+impl Lists {
+    /// Adds triangle `t`, whose box is `[lo, hi]`, to the list of the node at `p` being written.
+    #[inline]
+    pub fn push(&mut self, t: u32, p: &[f64; 3], rho: f64, lo: &[f64; 3], hi: &[f64; 3]) {
+        self.triangles.push(t);
+        self.halves.push(halves(p, rho, lo, hi));
+    }
+
+    /// Ends the list of node `i`, begun when `start` triangles were written (an empty one is
+    /// dropped).
+    #[inline]
+    pub fn close(&mut self, i: u32, start: usize) {
+        let count = self.triangles.len() - start;
+        if count > 0 {
+            self.nodes.push(i);
+            self.counts.push(count as u32);
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+}
 
 impl Near {
     /// Every node and edge (the full passes), queried from the root of the hierarchy.
@@ -136,23 +167,26 @@ impl Near {
         let (offsets, triangles) =
             group_by_node(mesh.n_nodes(), &boxes.tree.overlapping_pairs(bvh));
         let rho = boxes.rho;
-        let chunks: Vec<Lists> = par_node_chunks(mesh.n_nodes(), |range| {
-            let mut lists: Lists = Default::default();
-            for i in range {
-                let tris = &triangles[offsets[i] as usize..offsets[i + 1] as usize];
-                lists.0.push(tris.len() as u32);
-                lists.1.extend_from_slice(tris);
-                lists.2.extend(tris.iter().map(|&t| {
+        let listed: Vec<u32> = (0..mesh.n_nodes() as u32)
+            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
+            .collect();
+        let chunks: Vec<Lists> = par_node_chunks(&listed, |run| {
+            let mut lists = Lists::default();
+            for &i in run {
+                let start = lists.len();
+                let i_ = i as usize;
+                for &t in &triangles[offsets[i_] as usize..offsets[i_ + 1] as usize] {
                     let (lo, hi) = bvh.triangle_box(t as usize);
-                    halves(&mesh.coords[i], rho, &lo, &hi)
-                }));
+                    lists.push(t, &mesh.coords[i_], rho, &lo, &hi);
+                }
+                lists.close(i, start);
             }
             lists
         });
         Near::from_lists(mesh, adjacency, rho, chunks)
     }
 
-    /// The near part from the triangle lists of every node, by runs of nodes in node order (each
+    /// The near part from the triangle lists of the nodes, by runs of nodes in node order (each
     /// list ascending): the nodes with a non-empty list and their edges.
     pub(super) fn from_lists(
         mesh: &Mesh,
@@ -160,22 +194,24 @@ impl Near {
         rho: f64,
         chunks: Vec<Lists>,
     ) -> Near {
-        let mut offsets = Vec::with_capacity(mesh.n_nodes() + 1);
-        offsets.push(0u32);
-        let total = chunks.iter().map(|c| c.1.len()).sum();
+        let n = mesh.n_nodes();
+        let mut offsets = vec![0u32; n + 1];
+        let total = chunks.iter().map(Lists::len).sum();
+        let n_nodes = chunks.iter().map(|c| c.nodes.len()).sum();
+        let mut nodes = Vec::with_capacity(n_nodes);
         let (mut triangles, mut all_halves) =
             (Vec::with_capacity(total), Vec::with_capacity(total));
-        for (counts, tris, h) in chunks {
-            for c in counts {
-                offsets.push(offsets[offsets.len() - 1] + c);
+        for c in chunks {
+            for (&i, &count) in c.nodes.iter().zip(&c.counts) {
+                offsets[i as usize + 1] = count;
             }
-            triangles.extend_from_slice(&tris);
-            all_halves.extend_from_slice(&h);
+            nodes.extend_from_slice(&c.nodes);
+            triangles.extend_from_slice(&c.triangles);
+            all_halves.extend_from_slice(&c.halves);
         }
-        debug_assert_eq!(offsets.len(), mesh.n_nodes() + 1, "one list per node");
-        let nodes: Vec<u32> = (0..mesh.n_nodes() as u32)
-            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
-            .collect();
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
         // The edges of those nodes, ascending, through a bit set over the edges.
         let mut bits = vec![0u64; mesh.n_edges().div_ceil(64)];
         for &i in &nodes {
@@ -243,13 +279,14 @@ impl Near {
     }
 }
 
-/// `run` over the nodes `0..n` by runs of [`CHUNK`], in parallel, the results in node order.
+/// `run` over `nodes` by runs of [`CHUNK`], in parallel, the results in the order of `nodes`
+/// (the same for any number of threads).
 pub(super) fn par_node_chunks<T: Send>(
-    n: usize,
-    run: impl Fn(std::ops::Range<usize>) -> T + Sync,
+    nodes: &[u32],
+    run: impl Fn(&[u32]) -> T + Sync + Send,
 ) -> Vec<T> {
     use rayon::prelude::*;
-    (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| run(c * CHUNK..n.min((c + 1) * CHUNK))).collect()
+    nodes.par_chunks(CHUNK).map(run).collect()
 }
 
 /// Pairs `[node, triangle]` (each once) grouped by node, by counting: the offsets (one per node
