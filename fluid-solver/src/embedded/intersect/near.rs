@@ -18,7 +18,7 @@
 //! (none when one end is not near: its reach box, which holds the edge, meets no triangle box).
 //!
 //! Each recorded pair also keeps which halves of the reach box, split at the node along each
-//! axis, the triangle box reaches ([`halves`]). A query box on one side of the node along an
+//! axis, the triangle box reaches ([`Split::halves`]). A query box on one side of the node along an
 //! axis (an edge leaving the node upwards in x, say) needs a triangle box reaching that half, so
 //! a pass first tests those six bits and then the box itself: the same triangles, from a scan
 //! that skips most of the list without reading the triangle boxes.
@@ -70,29 +70,43 @@ impl NodeBoxes {
     }
 }
 
-/// The halves of a reach box, split at the node's position `p` along each axis and widened by
-/// `rho`, that the box `[lo, hi]` reaches: bit `2d` the lower (`lo[d] <= p[d] + rho`), bit
-/// `2d + 1` the upper (`hi[d] >= p[d] - rho`).
-#[inline]
-pub(super) fn halves(p: &[f64; 3], rho: f64, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
-    let mut bits = 0;
-    for d in 0..3 {
-        bits |= u8::from(lo[d] <= p[d] + rho) << (2 * d);
-        bits |= u8::from(hi[d] >= p[d] - rho) << (2 * d + 1);
-    }
-    bits
+/// A node's position `p` with the planes that split its reach box into halves along each axis,
+/// widened by `rho`: `p + rho` and `p - rho`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Split {
+    up: [f64; 3],
+    down: [f64; 3],
 }
 
-/// The halves ([`halves`]) every box overlapping `[lo, hi]` reaches: the lower along `d` when
-/// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho`.
-#[inline]
-fn needed(p: &[f64; 3], rho: f64, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
-    let mut bits = 0;
-    for d in 0..3 {
-        bits |= u8::from(hi[d] <= p[d] + rho) << (2 * d);
-        bits |= u8::from(lo[d] >= p[d] - rho) << (2 * d + 1);
+impl Split {
+    #[inline]
+    pub fn new(p: &[f64; 3], rho: f64) -> Split {
+        Split { up: p.map(|v| v + rho), down: p.map(|v| v - rho) }
     }
-    bits
+
+    /// The halves the box `[lo, hi]` reaches: bit `2d` the lower (`lo[d] <= p[d] + rho`), bit
+    /// `2d + 1` the upper (`hi[d] >= p[d] - rho`).
+    #[inline]
+    pub fn halves(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
+        let mut bits = 0;
+        for d in 0..3 {
+            bits |= u8::from(lo[d] <= self.up[d]) << (2 * d);
+            bits |= u8::from(hi[d] >= self.down[d]) << (2 * d + 1);
+        }
+        bits
+    }
+
+    /// The halves every box overlapping `[lo, hi]` reaches: the lower along `d` when
+    /// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho`.
+    #[inline]
+    fn needed(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
+        let mut bits = 0;
+        for d in 0..3 {
+            bits |= u8::from(hi[d] <= self.up[d]) << (2 * d);
+            bits |= u8::from(lo[d] >= self.down[d]) << (2 * d + 1);
+        }
+        bits
+    }
 }
 
 /// Mesh nodes and edges, each list ascending: the nodes whose reach box meets a triangle box and
@@ -106,7 +120,7 @@ pub struct Near {
     /// entry per mesh node and one more); empty for the full passes of [`Near::all`].
     offsets: Vec<u32>,
     triangles: Vec<u32>,
-    /// Per recorded triangle, the halves of the node's reach box its box reaches ([`halves`]).
+    /// Per recorded triangle, the halves of the node's reach box its box reaches ([`Split::halves`]).
     halves: Vec<u8>,
     /// The widening of the halves ([`NodeBoxes::rho`]).
     rho: f64,
@@ -123,11 +137,12 @@ pub(super) struct Lists {
 }
 
 impl Lists {
-    /// Adds triangle `t`, whose box is `[lo, hi]`, to the list of the node at `p` being written.
+    /// Adds triangle `t`, whose box is `[lo, hi]`, to the list being written of the node split
+    /// by `split`.
     #[inline]
-    pub fn push(&mut self, t: u32, p: &[f64; 3], rho: f64, lo: &[f64; 3], hi: &[f64; 3]) {
+    pub fn push(&mut self, t: u32, split: &Split, lo: &[f64; 3], hi: &[f64; 3]) {
         self.triangles.push(t);
-        self.halves.push(halves(p, rho, lo, hi));
+        self.halves.push(split.halves(lo, hi));
     }
 
     /// Ends the list of node `i`, begun when `start` triangles were written (an empty one is
@@ -175,9 +190,10 @@ impl Near {
             for &i in run {
                 let start = lists.len();
                 let i_ = i as usize;
+                let split = Split::new(&mesh.coords[i_], rho);
                 for &t in &triangles[offsets[i_] as usize..offsets[i_ + 1] as usize] {
                     let (lo, hi) = bvh.triangle_box(t as usize);
-                    lists.push(t, &mesh.coords[i_], rho, &lo, &hi);
+                    lists.push(t, &split, &lo, &hi);
                 }
                 lists.close(i, start);
             }
@@ -239,7 +255,7 @@ impl Near {
 
     /// Calls `visit` with every triangle of `bvh` whose box overlaps `[lo, hi]`, a box inside the
     /// reach box of node `i` at `p` (the node's edges, its occlusion ball, its projection box):
-    /// from the triangles recorded for `i` that reach the halves the box needs ([`halves`]), else
+    /// from the triangles recorded for `i` that reach the halves the box needs ([`Split::halves`]), else
     /// (none recorded, [`Near::all`]) by a query from the root. The same triangles either way (a
     /// triangle box meeting `[lo, hi]` meets the reach box), in another order. `bvh` must be the
     /// hierarchy `find` was given, unchanged since.
@@ -257,7 +273,7 @@ impl Near {
             return bvh.for_each_overlap(lo, hi, visit);
         };
         let (a, b) = (a as usize, b as usize);
-        let need = needed(p, self.rho, lo, hi);
+        let need = Split::new(p, self.rho).needed(lo, hi);
         for (&t, &h) in self.triangles[a..b].iter().zip(&self.halves[a..b]) {
             if h & need == need {
                 let (tlo, thi) = bvh.triangle_box(t as usize);

@@ -10,7 +10,7 @@
 //! hierarchy size triggers the next rebuild. Nothing here is state of the run: a restarted run
 //! rebuilds at its first step and gets the same [`Near`].
 
-use super::near::{group_by_node, par_node_chunks, Lists, Near, NodeBoxes};
+use super::near::{group_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
@@ -97,10 +97,11 @@ impl NearSkin {
                 let i_ = i as usize;
                 let start = lists.len();
                 let (lo, hi) = boxes.tree.triangle_box(i_);
+                let split = Split::new(&mesh.coords[i_], rho);
                 for &t in &self.kept[self.offsets[i_] as usize..self.offsets[i_ + 1] as usize] {
                     let (a, b) = bvh.triangle_box(t as usize);
                     if overlaps(&lo, &hi, &a, &b) {
-                        lists.push(t, &mesh.coords[i_], rho, &a, &b);
+                        lists.push(t, &split, &a, &b);
                     }
                 }
                 lists.close(i, start);
