@@ -140,7 +140,11 @@ impl KeptInside {
             }
         }
         let inside = &self.inside;
-        let in_d = |i: u32| near.nodes.binary_search(&i).is_ok_and(|k| decided[k].is_some());
+        let mut in_d = vec![false; mesh.n_nodes()];
+        for (&i, d) in near.nodes.iter().zip(decided) {
+            in_d[i as usize] = d.is_some();
+        }
+        let in_d = |i: u32| in_d[i as usize];
         let breaks_a = |&e: &u32| {
             let [i, j] = mesh.edges[e as usize];
             differs(mesh, inside, e) && !(in_d(i) && in_d(j))
