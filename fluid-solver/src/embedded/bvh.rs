@@ -243,6 +243,48 @@ impl Bvh {
         }
     }
 
+    /// [`Bvh::for_each_overlap`] skipping the subtrees whose box fails `keep(state, lo, hi)`, a
+    /// test that `visit(state, t)` may tighten (a nearest-point search prunes by its best so
+    /// far); the nearer child first, by the squared distance `order(state, lo, hi)`.
+    #[inline]
+    pub fn for_each_overlap_pruned<S>(
+        &self,
+        lo: &[f64; 3],
+        hi: &[f64; 3],
+        state: &mut S,
+        keep: impl Fn(&S, &[f64; 3], &[f64; 3]) -> bool,
+        order: impl Fn(&S, &[f64; 3], &[f64; 3]) -> f64,
+        mut visit: impl FnMut(&mut S, u32),
+    ) {
+        if self.tri_lo.is_empty() {
+            return;
+        }
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if !overlaps(&node.lo, &node.hi, lo, hi) || !keep(state, &node.lo, &node.hi) {
+                continue;
+            }
+            if node.count > 0 {
+                let leaf = &self.order[node.first as usize..(node.first + node.count) as usize];
+                for &t in leaf {
+                    if overlaps(&self.tri_lo[t as usize], &self.tri_hi[t as usize], lo, hi) {
+                        visit(state, t);
+                    }
+                }
+            } else {
+                let (a, b) = (node.first, node.first + 1);
+                let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+                let near_first = order(state, &na.lo, &na.hi) <= order(state, &nb.lo, &nb.hi);
+                // Depth is bounded by the median build, so two more slots always fit.
+                (stack[top], stack[top + 1]) = if near_first { (b, a) } else { (a, b) };
+                top += 2;
+            }
+        }
+    }
+
     /// Every pair `[k, t]` of an item `k` of this tree and an item `t` of `queries` whose boxes
     /// overlap, each pair once, by a traversal of both trees at once (pairs of nodes whose boxes
     /// overlap, down to pairs of leaves, whose items are tested box against box), in parallel

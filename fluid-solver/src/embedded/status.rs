@@ -168,7 +168,7 @@ pub fn swept_nodes_among(
 /// the triangles recorded for it (a node is inside its reach box).
 pub fn swept_nodes_near(mesh: &Mesh, surface: &Surface, bvh: &Bvh, near: &Near) -> Vec<u32> {
     swept_in(mesh, surface, bvh, &near.nodes, |p, i, visit| {
-        near.for_each_overlap(bvh, i, p, p, visit)
+        near.for_each_overlap(bvh, i, p, p, p, visit)
     })
 }
 

@@ -65,7 +65,9 @@ fn edge_cut(
     for (end, alpha) in [(i, 0.0), (j, 1.0)] {
         if occluded[end] {
             let r = super::OCCLUSION * adjacency.h_min[end];
-            if let Some((t, cp)) = at.nearest_point(mesh.coords[end], r, true, Some((near, end))) {
+            if let Some((t, cp)) =
+                at.nearest_point(mesh.coords[end], r, true, Some((near, end)), None)
+            {
                 return Some(at.cut(e, t, alpha, cp.bary));
             }
         }

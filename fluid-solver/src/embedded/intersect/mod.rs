@@ -10,6 +10,7 @@
 //! `Surface::node_at` at a stage time); the hierarchy's boxes must hold the triangles there
 //! ([`super::bvh::Bvh::refit`] covers `x_a` and `x_b`, [`super::bvh::Bvh::refit_with`] any other).
 
+mod closest;
 pub mod collision;
 pub mod near;
 pub mod projection;
@@ -24,6 +25,7 @@ use super::bvh::Bvh;
 use super::predicates::{closest_point, segment_triangle, unit_normal, Closest};
 use super::{CutEdge, Surface};
 use crate::mesh::Mesh;
+use closest::Nearest;
 
 /// Occlusion tolerance (thesis §4.3.2, `ε = 1e-8`), relative to the node's shortest edge: a node
 /// closer than `OCCLUSION * h_min(i)` to a triangle (where that triangle's phi is `>= 0`) is
@@ -159,7 +161,8 @@ impl SurfaceAt<'_> {
         let lo = [0, 1, 2].map(|d| p[d].min(q[d]));
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
         let mut best: Option<(f64, u32, [f64; 3])> = None;
-        near.for_each_overlap(self.bvh, near.end_with_fewer(i, j), &lo, &hi, |t| {
+        let k = near.end_with_fewer(i, j);
+        near.for_each_overlap(self.bvh, k, &mesh.coords[k], &lo, &hi, |t| {
             let [a, b, c] = self.corners(t);
             if let Some(h) = segment_triangle(p, q, a, b, c) {
                 if crack_aware && below_zero_or_nan(self.phi(t, h.bary)) {
@@ -176,32 +179,53 @@ impl SurfaceAt<'_> {
     /// The closest point of the surface to `p` among the triangles whose box meets the box of
     /// half-width `radius` around it (lowest triangle on ties), with phi `>= 0` there when
     /// `crack_aware`. With `within = Some((near, i))` that box lies inside the reach box of node
-    /// `i` and the triangles recorded for `i` are searched ([`Near::for_each_overlap`]).
+    /// `i` at `p` and the triangles recorded for `i` are searched ([`Near::for_each_overlap`]),
+    /// else the tree from its root. `seed`, the closest point to `p` of one of those triangles,
+    /// starts the search; boxes too far to beat the best so far are skipped ([`Nearest`]).
     fn nearest_point(
         &self,
         p: [f64; 3],
         radius: f64,
         crack_aware: bool,
         within: Option<(&Near, usize)>,
+        seed: Option<(u32, Closest)>,
     ) -> Option<(u32, Closest)> {
         let lo = p.map(|v| v - radius);
         let hi = p.map(|v| v + radius);
-        let mut best: Option<(u32, Closest)> = None;
-        let visit = |t| {
+        let mut nearest = Nearest::new(p);
+        if let Some((t, cp)) = seed {
+            let (a, b) = self.bvh.triangle_box(t as usize);
+            let phi_ok = !crack_aware || !below_zero_or_nan(self.phi(t, cp.bary));
+            if phi_ok && super::bvh::overlaps(&a, &b, &lo, &hi) {
+                nearest.offer(t, cp);
+            }
+        }
+        let visit = |nearest: &mut Nearest, t: u32| {
+            let (a, b) = self.bvh.triangle_box(t as usize);
+            if !nearest.may_beat(&a, &b) {
+                return;
+            }
             let [a, b, c] = self.corners(t);
             let cp = closest_point(p, a, b, c);
             if crack_aware && below_zero_or_nan(self.phi(t, cp.bary)) {
                 return;
             }
-            if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
-                best = Some((t, cp));
-            }
+            nearest.offer(t, cp);
         };
         match within {
-            Some((near, i)) => near.for_each_overlap(self.bvh, i, &lo, &hi, visit),
-            None => self.bvh.for_each_overlap(&lo, &hi, visit),
+            Some((near, i)) => {
+                near.for_each_overlap(self.bvh, i, &p, &lo, &hi, |t| visit(&mut nearest, t))
+            }
+            None => self.bvh.for_each_overlap_pruned(
+                &lo,
+                &hi,
+                &mut nearest,
+                |n, lo, hi| n.may_beat(lo, hi),
+                |n, lo, hi| n.box_dist2(lo, hi),
+                visit,
+            ),
         }
-        best
+        nearest.best
     }
 
     /// Occluded nodes (Alg. 4.2 step 3.1): within `OCCLUSION * h_min(i)` of the surface, among
@@ -216,7 +240,7 @@ impl SurfaceAt<'_> {
                 let r = OCCLUSION * h_min[i];
                 r.is_finite()
                     && self
-                        .nearest_point(mesh.coords[i], r, crack_aware, Some((near, i)))
+                        .nearest_point(mesh.coords[i], r, crack_aware, Some((near, i)), None)
                         .is_some_and(|(_, c)| c.dist2 <= r * r)
             })
             .collect();

@@ -16,33 +16,43 @@
 //! triangles recorded for `i` hold every triangle whose box meets it, and the pass tests those
 //! instead of querying the tree from its root. An edge takes the triangles of its end with fewer
 //! (none when one end is not near: its reach box, which holds the edge, meets no triangle box).
+//!
+//! Each recorded pair also keeps which halves of the reach box, split at the node along each
+//! axis, the triangle box reaches ([`Split::halves`]). A query box on one side of the node along an
+//! axis (an edge leaving the node upwards in x, say) needs a triangle box reaching that half, so
+//! a pass first tests those six bits and then the box itself: the same triangles, from a scan
+//! that skips most of the list without reading the triangle boxes.
 
 use super::OCCLUSION;
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
 
-/// Longest recorded triangle list searched as a list (a longer one is searched by the tree).
-pub const LIST_MAX: usize = 24;
+/// Nodes per parallel task of the list passes.
+const CHUNK: usize = 4096;
 
 /// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeBoxes {
     pub(super) tree: Bvh,
+    /// The largest occlusion radius of a node: the halves of each reach box overlap by it.
+    pub(super) rho: f64,
 }
 
 impl NodeBoxes {
     pub fn build(mesh: &Mesh, adjacency: &NodeEdges) -> NodeBoxes {
         let n = mesh.n_nodes();
         let (mut lo, mut hi) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut rho = 0.0f64;
         for i in 0..n {
             let (l, h) = adjacency.node_box(mesh, i);
             let r = OCCLUSION * adjacency.h_min[i];
             let r = if r.is_finite() { r } else { 0.0 };
+            rho = rho.max(r);
             lo.push(l.map(|v| v - r));
             hi.push(h.map(|v| v + r));
         }
-        NodeBoxes { tree: Bvh::over_boxes(lo, hi) }
+        NodeBoxes { tree: Bvh::over_boxes(lo, hi), rho }
     }
 
     /// Number of nodes.
@@ -60,10 +70,49 @@ impl NodeBoxes {
     }
 }
 
+/// A node's position `p` with the planes that split its reach box into halves along each axis,
+/// widened by `rho`: `p + rho` and `p - rho`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Split {
+    up: [f64; 3],
+    down: [f64; 3],
+}
+
+impl Split {
+    #[inline]
+    pub fn new(p: &[f64; 3], rho: f64) -> Split {
+        Split { up: p.map(|v| v + rho), down: p.map(|v| v - rho) }
+    }
+
+    /// The halves the box `[lo, hi]` reaches: bit `2d` the lower (`lo[d] <= p[d] + rho`), bit
+    /// `2d + 1` the upper (`hi[d] >= p[d] - rho`).
+    #[inline]
+    pub fn halves(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
+        let mut bits = 0;
+        for d in 0..3 {
+            bits |= u8::from(lo[d] <= self.up[d]) << (2 * d);
+            bits |= u8::from(hi[d] >= self.down[d]) << (2 * d + 1);
+        }
+        bits
+    }
+
+    /// The halves every box overlapping `[lo, hi]` reaches: the lower along `d` when
+    /// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho`.
+    #[inline]
+    fn needed(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
+        let mut bits = 0;
+        for d in 0..3 {
+            bits |= u8::from(hi[d] <= self.up[d]) << (2 * d);
+            bits |= u8::from(lo[d] >= self.down[d]) << (2 * d + 1);
+        }
+        bits
+    }
+}
+
 /// Mesh nodes and edges, each list ascending: the nodes whose reach box meets a triangle box and
 /// every edge touching one of them; with, from [`Near::find`], the triangles whose box meets each
-/// node's reach box.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// node's reach box and the halves of it each reaches.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Near {
     pub nodes: Vec<u32>,
     pub edges: Vec<u32>,
@@ -71,6 +120,45 @@ pub struct Near {
     /// entry per mesh node and one more); empty for the full passes of [`Near::all`].
     offsets: Vec<u32>,
     triangles: Vec<u32>,
+    /// Per recorded triangle, the halves of the node's reach box its box reaches ([`Split::halves`]).
+    halves: Vec<u8>,
+    /// The widening of the halves ([`NodeBoxes::rho`]).
+    rho: f64,
+}
+
+/// The triangle lists of a run of nodes: the nodes with a non-empty list (ascending), the length
+/// of each, the triangles and their halves.
+#[derive(Debug, Default)]
+pub(super) struct Lists {
+    nodes: Vec<u32>,
+    counts: Vec<u32>,
+    triangles: Vec<u32>,
+    halves: Vec<u8>,
+}
+
+impl Lists {
+    /// Adds triangle `t`, whose box is `[lo, hi]`, to the list being written of the node split
+    /// by `split`.
+    #[inline]
+    pub fn push(&mut self, t: u32, split: &Split, lo: &[f64; 3], hi: &[f64; 3]) {
+        self.triangles.push(t);
+        self.halves.push(split.halves(lo, hi));
+    }
+
+    /// Ends the list of node `i`, begun when `start` triangles were written (an empty one is
+    /// dropped).
+    #[inline]
+    pub fn close(&mut self, i: u32, start: usize) {
+        let count = self.triangles.len() - start;
+        if count > 0 {
+            self.nodes.push(i);
+            self.counts.push(count as u32);
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
 }
 
 impl Near {
@@ -81,6 +169,8 @@ impl Near {
             edges: (0..mesh.n_edges() as u32).collect(),
             offsets: Vec::new(),
             triangles: Vec::new(),
+            halves: Vec::new(),
+            rho: 0.0,
         }
     }
 
@@ -91,20 +181,53 @@ impl Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
         let (offsets, triangles) =
             group_by_node(mesh.n_nodes(), &boxes.tree.overlapping_pairs(bvh));
-        Near::from_lists(mesh, adjacency, offsets, triangles)
+        let rho = boxes.rho;
+        let listed: Vec<u32> = (0..mesh.n_nodes() as u32)
+            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
+            .collect();
+        let chunks: Vec<Lists> = par_node_chunks(&listed, |run| {
+            let mut lists = Lists::default();
+            for &i in run {
+                let start = lists.len();
+                let i_ = i as usize;
+                let split = Split::new(&mesh.coords[i_], rho);
+                for &t in &triangles[offsets[i_] as usize..offsets[i_ + 1] as usize] {
+                    let (lo, hi) = bvh.triangle_box(t as usize);
+                    lists.push(t, &split, &lo, &hi);
+                }
+                lists.close(i, start);
+            }
+            lists
+        });
+        Near::from_lists(mesh, adjacency, rho, chunks)
     }
 
-    /// The near part from the triangle lists of every node (CSR, each list ascending): the nodes
-    /// with a non-empty list and their edges.
+    /// The near part from the triangle lists of the nodes, by runs of nodes in node order (each
+    /// list ascending): the nodes with a non-empty list and their edges.
     pub(super) fn from_lists(
         mesh: &Mesh,
         adjacency: &NodeEdges,
-        offsets: Vec<u32>,
-        triangles: Vec<u32>,
+        rho: f64,
+        chunks: Vec<Lists>,
     ) -> Near {
-        let nodes: Vec<u32> = (0..mesh.n_nodes() as u32)
-            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
-            .collect();
+        let n = mesh.n_nodes();
+        let mut offsets = vec![0u32; n + 1];
+        let total = chunks.iter().map(Lists::len).sum();
+        let n_nodes = chunks.iter().map(|c| c.nodes.len()).sum();
+        let mut nodes = Vec::with_capacity(n_nodes);
+        let (mut triangles, mut all_halves) =
+            (Vec::with_capacity(total), Vec::with_capacity(total));
+        for c in chunks {
+            for (&i, &count) in c.nodes.iter().zip(&c.counts) {
+                offsets[i as usize + 1] = count;
+            }
+            nodes.extend_from_slice(&c.nodes);
+            triangles.extend_from_slice(&c.triangles);
+            all_halves.extend_from_slice(&c.halves);
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
         // The edges of those nodes, ascending, through a bit set over the edges.
         let mut bits = vec![0u64; mesh.n_edges().div_ceil(64)];
         for &i in &nodes {
@@ -120,7 +243,7 @@ impl Near {
                 word &= word - 1;
             }
         }
-        Near { nodes, edges, offsets, triangles }
+        Near { nodes, edges, offsets, triangles, halves: all_halves, rho }
     }
 
     /// The triangles whose box meets the reach box of node `i`, if recorded ([`Near::find`]).
@@ -131,30 +254,33 @@ impl Near {
     }
 
     /// Calls `visit` with every triangle of `bvh` whose box overlaps `[lo, hi]`, a box inside the
-    /// reach box of node `i` (the node's edges, its occlusion ball, its projection box): from the
-    /// triangles recorded for `i` when there are at most [`LIST_MAX`], else by a query from the
-    /// root (which prunes a long list faster). The same
-    /// triangles either way (a triangle box meeting `[lo, hi]` meets the reach box), in another
-    /// order. `bvh` must be the hierarchy `find` was given, unchanged since.
+    /// reach box of node `i` at `p` (the node's edges, its occlusion ball, its projection box):
+    /// from the triangles recorded for `i` that reach the halves the box needs ([`Split::halves`]), else
+    /// (none recorded, [`Near::all`]) by a query from the root. The same triangles either way (a
+    /// triangle box meeting `[lo, hi]` meets the reach box), in another order. `bvh` must be the
+    /// hierarchy `find` was given, unchanged since.
     #[inline]
     pub fn for_each_overlap(
         &self,
         bvh: &Bvh,
         i: usize,
+        p: &[f64; 3],
         lo: &[f64; 3],
         hi: &[f64; 3],
         mut visit: impl FnMut(u32),
     ) {
-        match self.triangles_of(i) {
-            Some(tris) if tris.len() <= LIST_MAX => {
-                for &t in tris {
-                    let (a, b) = bvh.triangle_box(t as usize);
-                    if overlaps(&a, &b, lo, hi) {
-                        visit(t);
-                    }
+        let (Some(&a), Some(&b)) = (self.offsets.get(i), self.offsets.get(i + 1)) else {
+            return bvh.for_each_overlap(lo, hi, visit);
+        };
+        let (a, b) = (a as usize, b as usize);
+        let need = Split::new(p, self.rho).needed(lo, hi);
+        for (&t, &h) in self.triangles[a..b].iter().zip(&self.halves[a..b]) {
+            if h & need == need {
+                let (tlo, thi) = bvh.triangle_box(t as usize);
+                if overlaps(&tlo, &thi, lo, hi) {
+                    visit(t);
                 }
             }
-            _ => bvh.for_each_overlap(lo, hi, visit),
         }
     }
 
@@ -167,6 +293,16 @@ impl Near {
             _ => i,
         }
     }
+}
+
+/// `run` over `nodes` by runs of [`CHUNK`], in parallel, the results in the order of `nodes`
+/// (the same for any number of threads).
+pub(super) fn par_node_chunks<T: Send>(
+    nodes: &[u32],
+    run: impl Fn(&[u32]) -> T + Sync + Send,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    nodes.par_chunks(CHUNK).map(run).collect()
 }
 
 /// Pairs `[node, triangle]` (each once) grouped by node, by counting: the offsets (one per node
@@ -238,6 +374,55 @@ mod tests {
         edges.sort_unstable();
         edges.dedup();
         assert_eq!(near.edges, edges, "{label}");
+    }
+
+    /// The scan of a node's recorded triangles, filtered by the halves, visits exactly the
+    /// triangles whose box meets the query box, for the boxes the passes ask (each edge of the
+    /// node, the node itself, its occlusion ball, its node box) and for boxes on a node plane.
+    #[test]
+    fn the_halves_skip_only_triangles_whose_box_misses_the_query() {
+        let mesh = cube_mesh(10, 0.3, 9);
+        let adj = NodeEdges::build(&mesh);
+        let boxes = NodeBoxes::build(&mesh, &adj);
+        let flat = box_surface([0.2, 0.3, 0.4], [0.8, 0.7, 0.4 + 1e-9], 3);
+        let mut queries = 0;
+        for s in [sphere([0.52, 0.47, 0.5], 0.3, 6), flat, plane(-0.5, 1.5, -0.5, 1.5, 0.5)] {
+            let bvh = Bvh::build(&s, 1e-9);
+            let near = Near::find(&mesh, &adj, &boxes, &bvh);
+            for &i in &near.nodes {
+                let i = i as usize;
+                let p = mesh.coords[i];
+                let r = OCCLUSION * adj.h_min[i];
+                let mut asks = vec![(p, p), (p.map(|v| v - r), p.map(|v| v + r))];
+                asks.push(adj.node_box(&mesh, i));
+                for (j, _) in adj.neighbours(&mesh, i) {
+                    let q = mesh.coords[j];
+                    asks.push((
+                        [0, 1, 2].map(|d| p[d].min(q[d])),
+                        [0, 1, 2].map(|d| p[d].max(q[d])),
+                    ));
+                    let mut flat_q = q;
+                    flat_q[1] = p[1];
+                    asks.push((
+                        [0, 1, 2].map(|d| p[d].min(flat_q[d])),
+                        [0, 1, 2].map(|d| p[d].max(flat_q[d])),
+                    ));
+                }
+                for (lo, hi) in asks {
+                    let mut got = Vec::new();
+                    near.for_each_overlap(&bvh, i, &p, &lo, &hi, |t| got.push(t));
+                    let want: Vec<u32> = (0..bvh.len() as u32)
+                        .filter(|&t| {
+                            let (a, b) = bvh.triangle_box(t as usize);
+                            overlaps(&a, &b, &lo, &hi)
+                        })
+                        .collect();
+                    assert_eq!(got, want, "node {i}");
+                    queries += usize::from(!want.is_empty());
+                }
+            }
+        }
+        assert!(queries > 1000, "{queries}");
     }
 
     #[test]

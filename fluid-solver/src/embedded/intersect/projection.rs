@@ -19,9 +19,10 @@
 //! Fig. 4.5, Case II): [`super::collision()`] is the algorithm for such bodies. Phi is not used:
 //! a cracked surface is not closed.
 
+use super::closest::Nearest;
 use super::{Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
-use crate::embedded::predicates::{closest_point, unit_normal, Closest, Feature};
+use crate::embedded::predicates::{closest_point, unit_normal, Feature};
 use crate::embedded::CutEdge;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Mesh;
@@ -139,7 +140,11 @@ impl KeptInside {
             }
         }
         let inside = &self.inside;
-        let in_d = |i: u32| near.nodes.binary_search(&i).is_ok_and(|k| decided[k].is_some());
+        let mut in_d = vec![false; mesh.n_nodes()];
+        for (&i, d) in near.nodes.iter().zip(decided) {
+            in_d[i as usize] = d.is_some();
+        }
+        let in_d = |i: u32| in_d[i as usize];
         let breaks_a = |&e: &u32| {
             let [i, j] = mesh.edges[e as usize];
             differs(mesh, inside, e) && !(in_d(i) && in_d(j))
@@ -223,7 +228,7 @@ fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, near: &Near, e: usize) -> Option<Cut
     let d = sub(q, p);
     let l2 = dot(d, d);
     let mid = add(p, scale(d, 0.5));
-    let (t, cp) = at.nearest_point(mid, l2.sqrt(), false, None)?;
+    let (t, cp) = at.nearest_point(mid, l2.sqrt(), false, None, None)?;
     let [a, b, c] = at.corners(t);
     let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
     let alpha = (dot(sub(x, p), d) / l2).clamp(0.0, 1.0);
@@ -241,21 +246,33 @@ fn decide(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>, near: &Near) ->
             let i = i as usize;
             let p = mesh.coords[i];
             let (lo, hi) = adjacency.node_box(mesh, i);
-            let mut best: Option<(u32, Closest)> = None;
-            near.for_each_overlap(at.bvh, i, &lo, &hi, |t| {
-                let [a, b, c] = at.corners(t);
-                let cp = closest_point(p, a, b, c);
-                if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
-                    best = Some((t, cp));
+            // The candidate whose box is nearest first, then the others that may beat it.
+            let mut nearest = Nearest::new(p);
+            let mut first: Option<(f64, u32)> = None;
+            near.for_each_overlap(at.bvh, i, &p, &lo, &hi, |t| {
+                let (a, b) = at.bvh.triangle_box(t as usize);
+                let d2 = nearest.box_dist2(&a, &b);
+                if first.is_none_or(|f| (d2, t) < f) {
+                    first = Some((d2, t));
                 }
             });
-            let (mut t, mut cp) = best?;
+            let (_, t0) = first?;
+            let [a, b, c] = at.corners(t0);
+            nearest.offer(t0, closest_point(p, a, b, c));
+            near.for_each_overlap(at.bvh, i, &p, &lo, &hi, |t| {
+                let (a, b) = at.bvh.triangle_box(t as usize);
+                if t != t0 && nearest.may_beat(&a, &b) {
+                    let [a, b, c] = at.corners(t);
+                    nearest.offer(t, closest_point(p, a, b, c));
+                }
+            });
+            let (mut t, mut cp) = nearest.best?;
             // The nearest triangle lies within that distance; unless the ball of that radius is
             // inside b_i, look for it beyond b_i.
             let r = cp.dist2.sqrt();
             if (0..3).any(|d| p[d] - r < lo[d] || p[d] + r > hi[d]) {
-                (t, cp) =
-                    at.nearest_point(p, r * (1.0 + 1e-12) + f64::MIN_POSITIVE, false, None)?;
+                let radius = r * (1.0 + 1e-12) + f64::MIN_POSITIVE;
+                (t, cp) = at.nearest_point(p, radius, false, None, Some((t, cp)))?;
             }
             let [a, b, c] = at.corners(t);
             let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
@@ -346,6 +363,76 @@ impl<'a> PseudoNormals<'a> {
             Feature::Face => self.face[t],
             Feature::Edge(k) => self.edge[t][k as usize],
             Feature::Vertex(k) => self.vertex[self.triangles[t][k as usize] as usize],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::embedded::bvh::{overlaps, Bvh};
+    use crate::embedded::intersect::NodeBoxes;
+    use crate::embedded::predicates::Closest;
+    use crate::embedded::tests::{box_surface, cube_mesh, sphere};
+
+    /// Steps 1-3 before the search was pruned: every triangle whose box meets the node box, then
+    /// every triangle whose box meets the ball's box, each closest point computed.
+    fn decide_unpruned(
+        mesh: &Mesh,
+        adjacency: &NodeEdges,
+        at: SurfaceAt<'_>,
+        i: usize,
+    ) -> Option<bool> {
+        let normals = PseudoNormals::new(at);
+        let p = mesh.coords[i];
+        let nearest = |lo: [f64; 3], hi: [f64; 3]| {
+            let mut best: Option<(u32, Closest)> = None;
+            for t in 0..at.bvh.len() as u32 {
+                let (a, b) = at.bvh.triangle_box(t as usize);
+                if overlaps(&a, &b, &lo, &hi) {
+                    let [a, b, c] = at.corners(t);
+                    let cp = closest_point(p, a, b, c);
+                    if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
+                        best = Some((t, cp));
+                    }
+                }
+            }
+            best
+        };
+        let (lo, hi) = adjacency.node_box(mesh, i);
+        let (mut t, mut cp) = nearest(lo, hi)?;
+        let r = cp.dist2.sqrt();
+        if (0..3).any(|d| p[d] - r < lo[d] || p[d] + r > hi[d]) {
+            let radius = r * (1.0 + 1e-12) + f64::MIN_POSITIVE;
+            (t, cp) = nearest(p.map(|v| v - radius), p.map(|v| v + radius))?;
+        }
+        let [a, b, c] = at.corners(t);
+        let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
+        Some(dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0)
+    }
+
+    /// The pruned steps 1-3 decide every near node as the unpruned search does, over the
+    /// recorded triangles and over the whole mesh.
+    #[test]
+    fn pruned_decisions_equal_the_unpruned_search() {
+        let mesh = cube_mesh(10, 0.3, 3);
+        let adj = NodeEdges::build(&mesh);
+        let boxes = NodeBoxes::build(&mesh, &adj);
+        for s in
+            [sphere([0.52, 0.47, 0.5], 0.3, 6), box_surface([0.3, 0.3, 0.4], [0.7, 0.6, 0.8], 2)]
+        {
+            let bvh = Bvh::build(&s, 1e-4);
+            let at = SurfaceAt::at_end(&s, &bvh).unwrap();
+            let near = Near::find(&mesh, &adj, &boxes, &bvh);
+            let want: Vec<Option<bool>> =
+                near.nodes.iter().map(|&i| decide_unpruned(&mesh, &adj, at, i as usize)).collect();
+            assert!(want.iter().filter(|d| d.is_some()).count() > 100);
+            assert_eq!(decide(&mesh, &adj, at, &near), want);
+            let all = Near::all(&mesh);
+            let full = decide(&mesh, &adj, at, &all);
+            for (&i, w) in near.nodes.iter().zip(&want) {
+                assert_eq!(full[i as usize], *w, "node {i}");
+            }
         }
     }
 }

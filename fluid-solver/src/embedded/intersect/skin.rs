@@ -10,7 +10,7 @@
 //! hierarchy size triggers the next rebuild. Nothing here is state of the run: a restarted run
 //! rebuilds at its first step and gets the same [`Near`].
 
-use super::near::{group_by_node, Near, NodeBoxes};
+use super::near::{group_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
@@ -31,6 +31,8 @@ pub struct NearSkin {
     /// Kept triangles of node `i`: `kept[offsets[i]..offsets[i + 1]]`, ascending.
     offsets: Vec<u32>,
     kept: Vec<u32>,
+    /// The nodes with kept triangles, ascending.
+    kept_nodes: Vec<u32>,
     /// Rebuilds so far (run statistics).
     pub rebuilds: usize,
 }
@@ -68,6 +70,10 @@ impl NearSkin {
         let widened = Bvh::over_boxes(self.lo.clone(), self.hi.clone());
         let pairs = boxes.tree.overlapping_pairs(&widened);
         (self.offsets, self.kept) = group_by_node(boxes.len(), &pairs);
+        let offsets = &self.offsets;
+        self.kept_nodes = (0..boxes.len() as u32)
+            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
+            .collect();
         self.rebuilds += 1;
     }
 
@@ -84,22 +90,25 @@ impl NearSkin {
         if !self.holds(bvh) {
             self.rebuild(boxes, bvh);
         }
-        let n = mesh.n_nodes();
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut triangles = Vec::new();
-        offsets.push(0u32);
-        for i in 0..n {
-            let kept = &self.kept[self.offsets[i] as usize..self.offsets[i + 1] as usize];
-            if !kept.is_empty() {
-                let (lo, hi) = boxes.tree.triangle_box(i);
-                triangles.extend(kept.iter().copied().filter(|&t| {
+        let rho = boxes.rho;
+        let chunks: Vec<Lists> = par_node_chunks(&self.kept_nodes, |run| {
+            let mut lists = Lists::default();
+            for &i in run {
+                let i_ = i as usize;
+                let start = lists.len();
+                let (lo, hi) = boxes.tree.triangle_box(i_);
+                let split = Split::new(&mesh.coords[i_], rho);
+                for &t in &self.kept[self.offsets[i_] as usize..self.offsets[i_ + 1] as usize] {
                     let (a, b) = bvh.triangle_box(t as usize);
-                    overlaps(&lo, &hi, &a, &b)
-                }));
+                    if overlaps(&lo, &hi, &a, &b) {
+                        lists.push(t, &split, &a, &b);
+                    }
+                }
+                lists.close(i, start);
             }
-            offsets.push(triangles.len() as u32);
-        }
-        Near::from_lists(mesh, adjacency, offsets, triangles)
+            lists
+        });
+        Near::from_lists(mesh, adjacency, rho, chunks)
     }
 
     /// Memory in bytes.
@@ -109,6 +118,7 @@ impl NearSkin {
             + size_of_val(&self.hi[..])
             + size_of_val(&self.offsets[..])
             + size_of_val(&self.kept[..])
+            + size_of_val(&self.kept_nodes[..])
     }
 }
 
