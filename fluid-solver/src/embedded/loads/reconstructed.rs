@@ -196,13 +196,27 @@ fn cell_cuts(view: &LoadView, joining: &[bool], cell: &Cell) -> [Option<usize>; 
     let mut cut_of = [None; 12];
     for (l, &[a, b]) in cell.kind.edges().iter().enumerate() {
         let (p, q) = (cell.nodes[a], cell.nodes[b]);
-        let key = [p.min(q), p.max(q)];
-        if let Ok(e) = view.mesh.edges.binary_search(&key) {
-            let k = view.cuts.binary_search_by_key(&(e as u32), |c| c.edge).ok();
+        if let Some(e) = edge_between(view, p.min(q), p.max(q)) {
+            let k = view.cuts.binary_search_by_key(&e, |c| c.edge).ok();
             cut_of[l] = k.filter(|&k| joining[k]);
         }
     }
     cut_of
+}
+
+/// The mesh edge `(p, q)`, `p < q`, found among `p`'s edges: those starting at `p` come last in
+/// its ascending row and lie side by side in `Mesh::edges` (sorted by their first node), so the
+/// scan from the row's end reads a few neighbouring entries where a search of the whole edge list
+/// would wander through it.
+#[inline]
+fn edge_between(view: &LoadView, p: u32, q: u32) -> Option<u32> {
+    view.adjacency
+        .edges_of(p as usize)
+        .iter()
+        .rev()
+        .map(|&e| (e, view.mesh.edges[e as usize]))
+        .take_while(|&(_, [a, _])| a == p)
+        .find_map(|(e, [_, b])| (b == q).then_some(e))
 }
 
 /// The local edge of `cell` joining local nodes `a` and `b`.
