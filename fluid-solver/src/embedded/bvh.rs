@@ -216,31 +216,14 @@ impl Bvh {
     /// Calls `visit` with every triangle whose box overlaps `[lo, hi]`, in leaf order.
     #[inline]
     pub fn for_each_overlap(&self, lo: &[f64; 3], hi: &[f64; 3], mut visit: impl FnMut(u32)) {
-        if self.tri_lo.is_empty() {
-            return;
-        }
-        let mut stack = [0u32; STACK];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if !overlaps(&node.lo, &node.hi, lo, hi) {
-                continue;
-            }
-            if node.count > 0 {
-                let leaf = &self.order[node.first as usize..(node.first + node.count) as usize];
-                for &t in leaf {
-                    if overlaps(&self.tri_lo[t as usize], &self.tri_hi[t as usize], lo, hi) {
-                        visit(t);
-                    }
-                }
-            } else {
-                // Depth is bounded by the median build, so two more slots always fit.
-                stack[top] = node.first + 1;
-                stack[top + 1] = node.first;
-                top += 2;
-            }
-        }
+        self.for_each_overlap_pruned(
+            lo,
+            hi,
+            &mut (),
+            |_, _, _| true,
+            |_, _, _| 0.0,
+            |_, t| visit(t),
+        )
     }
 
     /// [`Bvh::for_each_overlap`] skipping the subtrees whose box fails `keep(state, lo, hi)`, a

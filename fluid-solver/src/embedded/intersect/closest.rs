@@ -71,31 +71,41 @@ impl Nearest {
     }
 }
 
+/// The search before pruning, for the tests: every triangle whose box meets `[lo, hi]`, the
+/// lowest `(dist2, triangle)` of their closest points to `p`.
+#[cfg(test)]
+pub(crate) fn brute_nearest(
+    at: &super::SurfaceAt<'_>,
+    p: [f64; 3],
+    lo: [f64; 3],
+    hi: [f64; 3],
+) -> Option<(u32, Closest)> {
+    let mut best: Option<(u32, Closest)> = None;
+    for t in 0..at.bvh.len() as u32 {
+        let (a, b) = at.bvh.triangle_box(t as usize);
+        if crate::embedded::bvh::overlaps(&a, &b, &lo, &hi) {
+            let [a, b, c] = at.corners(t);
+            let cp = crate::embedded::predicates::closest_point(p, a, b, c);
+            if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
+                best = Some((t, cp));
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::embedded::adjacency::NodeEdges;
-    use crate::embedded::bvh::{overlaps, Bvh};
+    use crate::embedded::bvh::Bvh;
     use crate::embedded::intersect::{Near, NodeBoxes, SurfaceAt};
     use crate::embedded::predicates::closest_point;
     use crate::embedded::tests::{box_surface, cube_mesh, plane, sphere};
 
-    /// The search before pruning: every triangle whose box meets the query box, lowest
-    /// `(dist2, triangle)`.
+    /// [`brute_nearest`] in the cube of half-side `radius` about `p`.
     fn brute(at: &SurfaceAt<'_>, p: [f64; 3], radius: f64) -> Option<(u32, Closest)> {
-        let (lo, hi) = (p.map(|v| v - radius), p.map(|v| v + radius));
-        let mut best: Option<(u32, Closest)> = None;
-        for t in 0..at.bvh.len() as u32 {
-            let (a, b) = at.bvh.triangle_box(t as usize);
-            if overlaps(&a, &b, &lo, &hi) {
-                let [a, b, c] = at.corners(t);
-                let cp = closest_point(p, a, b, c);
-                if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
-                    best = Some((t, cp));
-                }
-            }
-        }
-        best
+        brute_nearest(at, p, p.map(|v| v - radius), p.map(|v| v + radius))
     }
 
     /// The pruned searches, from the root, from a node's recorded triangles and from a seed,

@@ -370,9 +370,8 @@ impl<'a> PseudoNormals<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::embedded::bvh::{overlaps, Bvh};
+    use crate::embedded::bvh::Bvh;
     use crate::embedded::intersect::NodeBoxes;
-    use crate::embedded::predicates::Closest;
     use crate::embedded::tests::{box_surface, cube_mesh, sphere};
 
     /// Steps 1-3 before the search was pruned: every triangle whose box meets the node box, then
@@ -385,20 +384,7 @@ mod tests {
     ) -> Option<bool> {
         let normals = PseudoNormals::new(at);
         let p = mesh.coords[i];
-        let nearest = |lo: [f64; 3], hi: [f64; 3]| {
-            let mut best: Option<(u32, Closest)> = None;
-            for t in 0..at.bvh.len() as u32 {
-                let (a, b) = at.bvh.triangle_box(t as usize);
-                if overlaps(&a, &b, &lo, &hi) {
-                    let [a, b, c] = at.corners(t);
-                    let cp = closest_point(p, a, b, c);
-                    if best.is_none_or(|(bt, bc)| (cp.dist2, t) < (bc.dist2, bt)) {
-                        best = Some((t, cp));
-                    }
-                }
-            }
-            best
-        };
+        let nearest = |lo, hi| crate::embedded::intersect::closest::brute_nearest(&at, p, lo, hi);
         let (lo, hi) = adjacency.node_box(mesh, i);
         let (mut t, mut cp) = nearest(lo, hi)?;
         let r = cp.dist2.sqrt();
