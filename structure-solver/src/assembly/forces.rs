@@ -309,16 +309,45 @@ impl FeModel {
                 }
             })
             .collect();
-        for (e, k) in self.elements.iter().zip(&mats) {
-            let dofs: Vec<usize> = e.nodes.iter().flat_map(|&n| 6 * n..6 * n + 6).collect();
-            for (a, &da) in dofs.iter().enumerate() {
-                for (b, &db) in dofs.iter().enumerate() {
-                    let v = k[(a, b)];
-                    if v != 0.0 {
-                        out.push(Triplet::new(da, db, v));
-                    }
+        push_blocks(&self.elements, &mats, out);
+    }
+}
+
+/// Appends the nonzero entries of each element matrix `mats[e]` (on the dofs of
+/// `elements[e]`'s nodes) to `out`, element by element in row-major order within each: the
+/// stream of a serial loop, written in parallel into the slices the counts give each element.
+fn push_blocks(
+    elements: &[crate::elements::Element],
+    mats: &[nalgebra::DMatrix<f64>],
+    out: &mut Vec<Triplet<usize, usize, f64>>,
+) {
+    let counts: Vec<usize> =
+        mats.par_iter().map(|k| k.iter().filter(|&&v| v != 0.0).count()).collect();
+    let total: usize = counts.iter().sum();
+    out.reserve(total);
+    let mut chunks = Vec::with_capacity(counts.len());
+    let mut rest = &mut out.spare_capacity_mut()[..total];
+    for &c in &counts {
+        let (head, tail) = rest.split_at_mut(c);
+        chunks.push(head);
+        rest = tail;
+    }
+    chunks.into_par_iter().zip(elements).zip(mats).with_min_len(64).for_each(|((chunk, e), k)| {
+        let dof = |a: usize| 6 * e.nodes[a / 6] + a % 6;
+        let mut written = 0;
+        for a in 0..k.nrows() {
+            let da = dof(a);
+            for b in 0..k.ncols() {
+                let v = k[(a, b)];
+                if v != 0.0 {
+                    chunk[written].write(Triplet::new(da, dof(b), v));
+                    written += 1;
                 }
             }
         }
-    }
+        assert_eq!(written, chunk.len(), "an element matrix changed while it was read");
+    });
+    // SAFETY: the chunks partition the first `total` spare slots and each chunk was written
+    // whole (asserted above; a panic there propagates before this line).
+    unsafe { out.set_len(out.len() + total) };
 }
