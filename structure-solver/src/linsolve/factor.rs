@@ -143,10 +143,11 @@ impl Ldlt {
         Arc::ptr_eq(&self.pattern, pattern)
     }
 
-    /// `x = S⁻¹ x` in place.
+    /// `x = S⁻¹ x` in place, on one thread (faer's parallel triangular solves gain nothing on
+    /// the bench plate: its supernodes are too small).
     pub fn solve_in_place(&self, x: &mut [f64]) {
         let p = &self.pattern;
-        let par = threads();
+        let par = Par::Seq;
         let mut mem = MemBuffer::new(p.symbolic.solve_in_place_scratch::<f64>(1, par));
         let n = x.len();
         let rhs = MatMut::from_column_major_slice_mut(x, n, 1);
