@@ -33,6 +33,9 @@ pub(super) fn threads() -> Par {
 pub(super) struct Jacobian {
     pub pattern: Arc<Pattern>,
     pub a: Vec<f64>,
+    /// The values of `Jᵀ` on the pattern (`at[k] = a[transpose[k]]`): the rows of `J`, read in
+    /// order by the products.
+    pub at: Vec<f64>,
     pub symmetric: bool,
     pub norm1: f64,
 }
@@ -42,6 +45,8 @@ impl Jacobian {
     /// column (free-dof numbers).
     pub fn new(pattern: Arc<Pattern>, a: Vec<f64>) -> Result<Self, FactorError> {
         let p = &pattern;
+        let mut at = p.take_any(a.len()); // every slot written
+        at.par_iter_mut().zip(&p.transpose).with_min_len(4096).for_each(|(o, &t)| *o = a[t]);
         // one parallel pass over the columns: the first non-finite slot, the largest column
         // sum, skew entry and entry (maxima: the same for any thread count)
         let col = |j: usize| {
@@ -52,7 +57,7 @@ impl Jacobian {
                     bad = k;
                 }
                 sum += v.abs();
-                skew = skew.max((v - a[p.transpose[k]]).abs());
+                skew = skew.max((v - at[k]).abs());
                 amax = amax.max(v.abs());
             }
             (bad, sum, skew, amax)
@@ -68,14 +73,16 @@ impl Jacobian {
                 a[bad], p.row_idx[bad]
             );
             p.give(a);
+            p.give(at);
             return Err(FactorError(err));
         }
-        Ok(Jacobian { symmetric: skew <= 1e-15 * amax, norm1, a, pattern })
+        Ok(Jacobian { symmetric: skew <= 1e-15 * amax, norm1, a, at, pattern })
     }
 
     /// `y = J x` (`transpose`: `Jᵀ x`).
     pub fn product(&self, x: &[f64], y: &mut [f64], transpose: bool) {
-        self.pattern.product(&self.a, x, y, transpose);
+        let values = if transpose { &self.a } else { &self.at };
+        self.pattern.product(values, x, y);
     }
 
     /// `J` as a faer matrix.
@@ -87,6 +94,7 @@ impl Jacobian {
 impl Drop for Jacobian {
     fn drop(&mut self) {
         self.pattern.give(std::mem::take(&mut self.a));
+        self.pattern.give(std::mem::take(&mut self.at));
     }
 }
 
@@ -103,11 +111,9 @@ impl Ldlt {
     pub fn of(j: &Jacobian) -> Option<Self> {
         let p = &j.pattern;
         let mut s = p.take_any(j.a.len()); // every slot written
-        s.par_iter_mut().zip(&j.a).zip(&p.transpose).with_min_len(4096).for_each(
-            |((sk, &v), &t)| {
-                *sk = 0.5 * (v + j.a[t]);
-            },
-        );
+        s.par_iter_mut().zip(&j.a).zip(&j.at).with_min_len(4096).for_each(|((sk, &v), &t)| {
+            *sk = 0.5 * (v + t);
+        });
         let mut values = p.take_any(p.symbolic.len_val()); // zeroed by the factorisation
         let par = threads();
         let ok = {
@@ -137,7 +143,8 @@ impl Ldlt {
         Arc::ptr_eq(&self.pattern, pattern)
     }
 
-    /// `x = S⁻¹ x` in place.
+    /// `x = S⁻¹ x` in place, on one thread (faer's parallel triangular solves gain nothing on
+    /// the bench plate: its supernodes are too small).
     pub fn solve_in_place(&self, x: &mut [f64]) {
         let p = &self.pattern;
         let par = Par::Seq;

@@ -203,7 +203,7 @@ impl Pattern {
     /// Returns an array to the pool.
     pub fn give(&self, v: Vec<f64>) {
         if let Ok(mut p) = self.pool.lock() {
-            if p.len() < 6 {
+            if p.len() < 8 {
                 p.push(v);
             }
         }
@@ -213,19 +213,15 @@ impl Pattern {
         SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx)
     }
 
-    /// `y = J x` (`transpose`: `Jᵀ x`) for the values `a` on this pattern, in parallel over
-    /// the entries of `y`. Each `y_i` sums its terms in increasing column order whatever the
-    /// thread count: `(J x)_i = Σ_j J_ij x_j` reads column `i` of the pattern through
-    /// `transpose` (the pattern is structurally symmetric).
-    pub fn product(&self, a: &[f64], x: &[f64], y: &mut [f64], transpose: bool) {
-        let (ptr, rows, tr) = (&self.col_ptr, &self.row_idx, &self.transpose);
+    /// `y = Jᵀ x` for the values `a` of `J` on this pattern, in parallel over the entries of
+    /// `y`; `J x` is this product with the values of `Jᵀ` (the pattern is structurally
+    /// symmetric). Each `y_i` sums its terms in increasing column order whatever the thread
+    /// count.
+    pub fn product(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
+        let (ptr, rows) = (&self.col_ptr, &self.row_idx);
         y.par_iter_mut().enumerate().with_min_len(512).for_each(|(i, yi)| {
             let range = ptr[i]..ptr[i + 1];
-            *yi = if transpose {
-                rows[range.clone()].iter().zip(&a[range]).map(|(&j, v)| v * x[j]).sum()
-            } else {
-                rows[range.clone()].iter().zip(&tr[range]).map(|(&j, &t)| a[t] * x[j]).sum()
-            };
+            *yi = rows[range.clone()].iter().zip(&a[range]).map(|(&j, v)| v * x[j]).sum();
         });
     }
 }
