@@ -61,36 +61,40 @@ pub(super) fn vertex_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3],
     vertex_loads_in(view, &cut_cells(view), sink);
 }
 
-/// The cells holding both ends of some cut edge, ascending: every cell with a cut edge, so every
-/// cell that can hold a polygon.
-pub(super) fn cut_cells(view: &LoadView) -> Vec<u32> {
-    let mut cells = Vec::with_capacity(8 * view.cuts.len());
-    for c in view.cuts {
+/// The cut cells with their cut edges: a pair `(cell, cut)` for every cell holding both ends of
+/// cut edge `cut`, ascending. Every cell with a cut edge appears, so every cell that can hold a
+/// polygon.
+pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
+    let mut pairs = Vec::with_capacity(8 * view.cuts.len());
+    for (k, c) in view.cuts.iter().enumerate() {
         let [i, j] = view.mesh.edges[c.edge as usize];
         let around = view.adjacency.cells_of(i as usize);
-        cells.extend(around.iter().filter(|&&k| view.mesh.cells[k as usize].nodes().contains(&j)));
+        let holding =
+            around.iter().filter(|&&cell| view.mesh.cells[cell as usize].nodes().contains(&j));
+        pairs.extend(holding.map(|&cell| (cell, k as u32)));
     }
-    cells.sort_unstable();
-    cells.dedup();
-    cells
+    pairs.sort_unstable();
+    pairs
 }
 
-/// [`vertex_loads`] over the given `cells` (ascending), which must include every cut cell.
+/// [`vertex_loads`] over the `(cell, cut)` pairs `pairs` (ascending), which must include every
+/// cut edge of every cut cell.
 pub(super) fn vertex_loads_in(
     view: &LoadView,
-    cells: &[u32],
+    pairs: &[(u32, u32)],
     mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
     let joining = joining_cuts(view);
+    let cells: Vec<&[(u32, u32)]> = pairs.chunk_by(|a, b| a.0 == b.0).collect();
     // The cells' contributions in parallel, handed to `sink` in cell order (as one pass would).
     let per_chunk: Vec<Vec<Contribution>> = cells
         .par_chunks(CELLS_PER_TASK)
         .map(|chunk| {
             let mut found = Vec::new();
             let mut polygon = Vec::with_capacity(12);
-            for &k in chunk {
-                let cell = &view.mesh.cells[k as usize];
-                let cut_of = cell_cuts(view, &joining, cell);
+            for cuts in chunk {
+                let cell = &view.mesh.cells[cuts[0].0 as usize];
+                let cut_of = cell_cuts(view, &joining, cell, cuts);
                 if cut_of.iter().flatten().count() < 3 {
                     continue;
                 }
@@ -191,32 +195,30 @@ fn open_parts(surface: &Surface) -> Vec<Option<u32>> {
 }
 
 /// For each local edge of `cell`, the index of its cut edge, if it is cut and joins the
-/// reconstruction (`joining`, per cut edge).
-fn cell_cuts(view: &LoadView, joining: &[bool], cell: &Cell) -> [Option<usize>; 12] {
+/// reconstruction (`joining`, per cut edge), from the cell's `(cell, cut)` pairs.
+fn cell_cuts(
+    view: &LoadView,
+    joining: &[bool],
+    cell: &Cell,
+    pairs: &[(u32, u32)],
+) -> [Option<usize>; 12] {
     let mut cut_of = [None; 12];
-    for (l, &[a, b]) in cell.kind.edges().iter().enumerate() {
-        let (p, q) = (cell.nodes[a], cell.nodes[b]);
-        if let Some(e) = edge_between(view, p.min(q), p.max(q)) {
-            let k = view.cuts.binary_search_by_key(&e, |c| c.edge).ok();
-            cut_of[l] = k.filter(|&k| joining[k]);
+    let local = cell.kind.edges();
+    for &(_, k) in pairs {
+        let k = k as usize;
+        if !joining[k] {
+            continue;
+        }
+        let [i, j] = view.mesh.edges[view.cuts[k].edge as usize];
+        let l = local.iter().position(|&[a, b]| {
+            let (p, q) = (cell.nodes[a], cell.nodes[b]);
+            (p.min(q), p.max(q)) == (i, j)
+        });
+        if let Some(l) = l {
+            cut_of[l] = Some(k);
         }
     }
     cut_of
-}
-
-/// The mesh edge `(p, q)`, `p < q`, found among `p`'s edges: those starting at `p` come last in
-/// its ascending row and lie side by side in `Mesh::edges` (sorted by their first node), so the
-/// scan from the row's end reads a few neighbouring entries where a search of the whole edge list
-/// would wander through it.
-#[inline]
-fn edge_between(view: &LoadView, p: u32, q: u32) -> Option<u32> {
-    view.adjacency
-        .edges_of(p as usize)
-        .iter()
-        .rev()
-        .map(|&e| (e, view.mesh.edges[e as usize]))
-        .take_while(|&(_, [a, _])| a == p)
-        .find_map(|(e, [_, b])| (b == q).then_some(e))
 }
 
 /// The local edge of `cell` joining local nodes `a` and `b`.
