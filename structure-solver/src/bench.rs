@@ -39,8 +39,8 @@ pub struct ExplicitBench {
     pub lanes: usize,
     /// The instruction set the block loop ran on.
     pub simd_path: &'static str,
-    /// State and work arrays per element (double-buffered state, mesh, element forces,
-    /// incidence), without the nodal arrays.
+    /// State and work arrays per element (double-buffered state, mesh, element node slots and
+    /// shared-node rows of the first thread count), without the nodal arrays.
     pub bytes_per_element: f64,
     /// Natural order on the first thread count (1 by default): the headline numbers.
     pub element_updates_per_s_per_core: f64,

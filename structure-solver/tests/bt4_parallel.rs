@@ -3,7 +3,8 @@
 //! one material each.
 
 use structure_solver::elements::bt4::LANES;
-use structure_solver::elements::bt4::{Bt4, Bt4Error, Bt4Settings, SimdPath, BLOCKS_PER_TASK};
+use structure_solver::elements::bt4::{Bt4, Bt4Error, Bt4Settings, SimdPath};
+use structure_solver::elements::incidence::chunk_bounds;
 use structure_solver::material::{Elastic, J2};
 
 fn steel() -> J2 {
@@ -105,10 +106,10 @@ fn pool(threads: usize) -> rayon::ThreadPool {
 
 #[test]
 fn forces_and_state_are_bitwise_the_same_on_1_and_2_threads() {
-    // 31 x 27 = 837 elements: 105 blocks (the last one partial), 7 tasks of the block phase.
+    // 31 x 27 = 837 elements: 105 blocks (the last one partial), 13 chunks on 2 threads.
     let plate = Plate::new(31, 27);
     let ne = plate.conn.len();
-    assert!(ne > 4 * BLOCKS_PER_TASK * LANES && !ne.is_multiple_of(LANES));
+    assert!(chunk_bounds(ne, LANES, 2).len() > 4 && !ne.is_multiple_of(LANES));
     let run = |threads: usize| {
         let mut bt4 = Bt4::new(plate.conn.clone(), vec![0.01; ne], steel(), Bt4Settings::default());
         let f = pool(threads).install(|| drive(&plate, &mut bt4, 12, SimdPath::detected()));

@@ -22,7 +22,6 @@ mod forces;
 mod kernel;
 mod strain;
 
-pub use forces::ELEMENTS_PER_TASK;
 pub use strain::{frame, rows, Frame, Rows, N_DOF};
 
 use rayon::prelude::*;
@@ -315,7 +314,7 @@ impl Blt3 {
     }
 
     /// Bytes of state and work arrays per element (double-buffered state, connectivity,
-    /// thickness, material index, reference bound, element forces, node incidence).
+    /// thickness, material index, reference bound, element node slots and shared-node rows).
     pub fn bytes_per_element(&self) -> f64 {
         let s = &self.committed;
         let state = 2 * 8 * (s.stress.len() + s.alpha.len() + s.shear.len());

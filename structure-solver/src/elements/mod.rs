@@ -11,7 +11,7 @@ pub mod bt4;
 pub mod corotation;
 pub mod dkt;
 pub mod element;
-mod incidence;
+pub mod incidence;
 pub mod layered;
 pub mod mitc4;
 pub mod rotation;

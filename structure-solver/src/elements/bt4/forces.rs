@@ -1,15 +1,11 @@
 //! The explicit BT4 loop over threads and vector units (DESIGN §6, "Speed").
 //!
-//! One pass in two phases, both over threads:
-//! 1. blocks of [`LANES`] elements, [`BLOCKS_PER_TASK`] blocks a task: gather the block's
-//!    nodes, run the kernel, write the trial state and the element forces (24 per element) to
-//!    a work array, so no two tasks write the same memory;
-//! 2. nodes, a node's force summing its elements' contributions in ascending element order
-//!    (`elements::incidence`), exactly the order of a serial scatter.
-//!
-//! So the forces are bitwise independent of the thread count and of rayon's splitting. On one
-//! thread the blocks add their forces to the nodes as they go, in ascending element order: the
-//! same sums without the work array.
+//! One pass over chunks of whole blocks of [`LANES`] elements, a task each
+//! (`elements::incidence`): a block gathers its nodes, runs the kernel and writes its trial
+//! state; its element forces go straight into the nodes its chunk owns and into work rows for
+//! the nodes chunks share, which then sum their rows in ascending element order. Every node's
+//! force is the serial scatter's sum, so the forces are bitwise independent of the thread
+//! count. One thread is one chunk and writes no work row.
 //!
 //! The vector width is chosen at run time ([`SimdPath`], detected through `pulp`): the block
 //! loop is compiled in functions of the AVX-512 (x86-64-v4) and AVX2 + FMA (x86-64-v3)
@@ -22,13 +18,11 @@ use rayon::prelude::*;
 
 use super::kernel::{element_block, BlockState, Constants};
 use super::{LANES, N_HOURGLASS, N_STRESS};
-use crate::elements::incidence::Incidence;
+use crate::elements::incidence::{chunk_bounds, split_at_bounds, ChunkSink, NodeScatter};
 use crate::material::lanes::{Block8, Lanes};
 
-/// Blocks of elements per task of the first phase.
+/// Blocks of elements per task of the stable-step bound.
 pub const BLOCKS_PER_TASK: usize = 16;
-/// Element forces per element in the work array: 6 per node, `[node][dof]`.
-const F_PER_ELEMENT: usize = 24;
 
 /// An instruction set the block loop is compiled for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -128,14 +122,6 @@ pub(super) struct Bt4View<'a> {
     pub settings: &'a super::Bt4Settings,
 }
 
-/// Where a task puts its element forces.
-enum Sink<'a> {
-    /// Its rows of the work array.
-    Rows(&'a mut [f64]),
-    /// Added to the nodal forces (6 per node) in element order.
-    Nodes(&'a mut [f64]),
-}
-
 /// The blocks of one task.
 struct BlockTask<'a> {
     shared: &'a Shared<'a>,
@@ -147,7 +133,7 @@ struct BlockTask<'a> {
     stress_new: &'a mut [f64],
     alpha_new: &'a mut [f64],
     hg_new: &'a mut [f64],
-    forces: Sink<'a>,
+    forces: ChunkSink<'a>,
 }
 
 impl BlockOp for BlockTask<'_> {
@@ -212,27 +198,10 @@ impl BlockOp for BlockTask<'_> {
                 }
             }
             let fe = out;
-            match &mut self.forces {
-                Sink::Rows(rows) => {
-                    let n = LANES * F_PER_ELEMENT;
-                    let out = &mut rows[j * n..(j + 1) * n];
-                    for l in 0..LANES {
-                        for i in 0..4 {
-                            for d in 0..6 {
-                                out[(l * 4 + i) * 6 + d] = fe[i][d][l];
-                            }
-                        }
-                    }
-                }
-                Sink::Nodes(f) => {
-                    for l in 0..valid {
-                        for (i, &n) in bt4.conn[e0 + l].iter().enumerate() {
-                            let fnode = &mut f[6 * n as usize..6 * n as usize + 6];
-                            for d in 0..6 {
-                                fnode[d] += fe[i][d][l];
-                            }
-                        }
-                    }
+            for l in 0..valid {
+                let e = e0 + l;
+                for (i, &n) in bt4.conn[e].iter().enumerate() {
+                    self.forces.add(e, i, n, std::array::from_fn(|d| fe[i][d][l]));
                 }
             }
         }
@@ -254,18 +223,18 @@ pub(super) fn lanes<R: Block8, const C: usize>(a: [[[f64; LANES]; C]; 4]) -> [[R
 /// Work arrays of the loop.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Work {
-    pub incidence: Incidence,
-    /// Element forces, `[element][node][dof]`, padded to whole blocks.
-    pub forces: Vec<f64>,
+    /// The chunks of the element pass and the nodes they share.
+    pub scatter: NodeScatter,
 }
 
 impl Work {
     pub fn bytes(&self) -> usize {
-        self.incidence.bytes() + 8 * self.forces.len()
+        self.scatter.bytes()
     }
 }
 
-/// Phase 1 and 2 of the module docs on `path`; `None` when the processor lacks it.
+/// The element pass and the node phase of the module docs on `path`; `None` when the
+/// processor lacks it.
 pub(super) fn internal_force(
     path: SimdPath,
     bt4: &Bt4View<'_>,
@@ -279,56 +248,48 @@ pub(super) fn internal_force(
         return None;
     }
     let nn = x_end.len();
-    if work.incidence.n_nodes() != nn {
-        work.incidence = Incidence::new(bt4.conn, nn);
+    let bounds = chunk_bounds(bt4.conn.len(), LANES, rayon::current_num_threads());
+    if !work.scatter.fits(nn, &bounds) {
+        work.scatter = NodeScatter::new(bt4.conn, nn, bounds);
     }
-    let nb = bt4.conn.len().div_ceil(LANES);
     let np = bt4.settings.rule.len();
-    let t = BLOCKS_PER_TASK;
     let (old, new) = state;
     let shared = Shared { bt4, x_end, du };
-    if rayon::current_num_threads() == 1 {
-        let op = BlockTask {
+    // the chunks' blocks and their slices of the trial state
+    let blocks: Vec<usize> = work.scatter.bounds().iter().map(|b| b.div_ceil(LANES)).collect();
+    let (stress_new, alpha_new, hg_new) = (
+        split_at_bounds(&mut new.stress, &blocks, np * N_STRESS * LANES),
+        split_at_bounds(&mut new.alpha, &blocks, np * LANES),
+        split_at_bounds(&mut new.hourglass, &blocks, N_HOURGLASS * LANES),
+    );
+    let tasks: Vec<_> = work
+        .scatter
+        .sinks(f)
+        .into_iter()
+        .zip(stress_new)
+        .zip(alpha_new)
+        .zip(hg_new)
+        .zip(blocks.windows(2))
+        .map(|((((sink, sn), an), hn), b)| BlockTask {
             shared: &shared,
-            first_block: 0,
-            n_blocks: nb,
-            stress_old: &old.stress,
-            alpha_old: &old.alpha,
-            hg_old: &old.hourglass,
-            stress_new: &mut new.stress,
-            alpha_new: &mut new.alpha,
-            hg_new: &mut new.hourglass,
-            forces: Sink::Nodes(f),
-        };
-        return path.run(op);
-    }
-    work.forces.resize(nb * LANES * F_PER_ELEMENT, 0.0);
-    (
-        old.stress.par_chunks(t * np * N_STRESS * LANES),
-        old.alpha.par_chunks(t * np * LANES),
-        old.hourglass.par_chunks(t * N_HOURGLASS * LANES),
-        new.stress.par_chunks_mut(t * np * N_STRESS * LANES),
-        new.alpha.par_chunks_mut(t * np * LANES),
-        new.hourglass.par_chunks_mut(t * N_HOURGLASS * LANES),
-        work.forces.par_chunks_mut(t * LANES * F_PER_ELEMENT),
-    )
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(task, (so, ao, ho, sn, an, hn, fo))| {
-            let op = BlockTask {
-                shared: &shared,
-                first_block: task * t,
-                n_blocks: fo.len() / (LANES * F_PER_ELEMENT),
-                stress_old: so,
-                alpha_old: ao,
-                hg_old: ho,
-                stress_new: sn,
-                alpha_new: an,
-                hg_new: hn,
-                forces: Sink::Rows(fo),
-            };
+            first_block: b[0],
+            n_blocks: b[1] - b[0],
+            stress_old: &old.stress[b[0] * np * N_STRESS * LANES..],
+            alpha_old: &old.alpha[b[0] * np * LANES..],
+            hg_old: &old.hourglass[b[0] * N_HOURGLASS * LANES..],
+            stress_new: sn,
+            alpha_new: an,
+            hg_new: hn,
+            forces: sink,
+        })
+        .collect();
+    if tasks.len() == 1 {
+        tasks.into_iter().for_each(|op| path.run(op).expect("a supported path"));
+    } else {
+        tasks.into_par_iter().with_max_len(1).for_each(|op| {
             path.run(op).expect("a supported path");
         });
-    work.incidence.add_rows(&work.forces, f);
+    }
+    work.scatter.sum_shared(f);
     Some(())
 }

@@ -234,7 +234,7 @@ impl Bt4 {
     /// full committed state (stresses, equivalent plastic strain and hourglass stresses at
     /// every point, copied into the trial state too): a phantom element of the phantom-node
     /// formulation (thesis §3.5, Fig. 3.2). A new block of zero state is opened when the last
-    /// one is full; the node incidence is rebuilt at the next force. Returns the new
+    /// one is full; the node chunks are rebuilt at the next force. Returns the new
     /// element's index, or `None` when `e` is not an element of the part.
     pub fn push_copy(&mut self, e: usize, conn: [u32; 4]) -> Option<usize> {
         if e >= self.conn.len() {
@@ -276,7 +276,7 @@ impl Bt4 {
     }
 
     /// Bytes of state and work arrays per element (double-buffered state, connectivity,
-    /// thickness, material index, element forces, node incidence).
+    /// thickness, material index, element node slots and shared-node rows).
     pub fn bytes_per_element(&self) -> f64 {
         let s = &self.committed;
         let state = 2 * 8 * (s.stress.len() + s.alpha.len() + s.hourglass.len());
