@@ -128,8 +128,8 @@ pub struct IterationPieces {
     pub element_tangents_one_thread: f64,
     pub factorisation: f64,
     pub solve: f64,
-    /// Triplets of the assembled tangent (before summing duplicates).
-    pub tangent_triplets: usize,
+    /// Entries of the tangent's stream (before summing duplicates).
+    pub tangent_entries: usize,
 }
 
 /// Times each piece of a Newton iteration of `model` at its current configuration.
@@ -149,8 +149,8 @@ fn pieces(model: &mut FeModel) -> anyhow::Result<IterationPieces> {
     let n = model.n_dof();
     let mut fi = vec![0.0; n];
     let internal_force = best(&mut || model.internal_force(&mut fi));
-    let mut triplets = Vec::new();
-    let tangent_assembly = best(&mut || model.tangent(0.0, &mut triplets));
+    let mut tangent = crate::model::Tangent::default();
+    let tangent_assembly = best(&mut || model.tangent(0.0, &mut tangent));
     let element_tangents_one_thread = best(&mut || {
         let (x, r) = (model.positions(), model.rotations());
         for (i, e) in model.elements().iter().enumerate() {
@@ -162,10 +162,10 @@ fn pieces(model: &mut FeModel) -> anyhow::Result<IterationPieces> {
     let mass = model.lumped_mass().to_vec();
     let mut solver = FreeSolver::new(model);
     // the first factorisation makes the symbolic analysis
-    let lu = solver.factor(&triplets, 1.0, Some((1e8, &mass)))?;
+    let lu = solver.factor(&tangent, 1.0, Some((1e8, &mass)))?;
     let mut result = Ok(());
     let factorisation = best(&mut || {
-        if let Err(e) = solver.factor(&triplets, 1.0, Some((1e8, &mass))) {
+        if let Err(e) = solver.factor(&tangent, 1.0, Some((1e8, &mass))) {
             result = Err(e);
         }
     });
@@ -180,7 +180,7 @@ fn pieces(model: &mut FeModel) -> anyhow::Result<IterationPieces> {
         element_tangents_one_thread,
         factorisation,
         solve,
-        tangent_triplets: triplets.len(),
+        tangent_entries: tangent.len(),
     })
 }
 

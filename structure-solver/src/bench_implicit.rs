@@ -59,9 +59,9 @@ pub struct ImplicitRun {
 /// Seconds of the pieces of a Newton iteration (best of two), at the final configuration.
 #[derive(Debug, Serialize)]
 pub struct Pieces {
-    /// `Model::tangent` into triplets.
+    /// `Model::tangent`: the element blocks.
     pub tangent: f64,
-    /// The triplets into the matrix through the scatter map (`FreeSolver::assemble`).
+    /// The blocks into the matrix through the scatter map (`FreeSolver::assemble`).
     pub assemble: f64,
     /// A fresh `LDLᵀ` of the symmetric part (`FreeSolver::factor`).
     pub factorisation: f64,
@@ -110,9 +110,8 @@ fn best_of_two(mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64>
 fn pieces(model: &mut FeModel) -> anyhow::Result<Pieces> {
     let mass = model.lumped_mass().to_vec();
     let cm = 4.0 / (DT * DT);
-    let mut trip = Vec::new();
+    let mut trip = crate::model::Tangent::default();
     let tangent = best_of_two(|| {
-        trip.clear();
         model.tangent(0.0, &mut trip);
         Ok(())
     })?;

@@ -29,16 +29,16 @@ pub fn lowest_frequencies(model: &mut dyn Model, n: usize) -> Result<Vec<f64>, M
     let nf = solver.free.len();
     let mass = solver.free.gather(model.lumped_mass());
     let mass: Vec<f64> = (0..nf).map(|i| mass[(i, 0)]).collect();
-    let mut trip = Vec::new();
+    let mut trip = crate::model::Tangent::default();
     model.tangent(0.0, &mut trip);
     // the symmetric part ½(K + Kᵀ)
     let sym: Vec<Triplet<usize, usize, f64>> = trip
-        .iter()
+        .triplets()
         .flat_map(|e| {
             [Triplet::new(e.row, e.col, 0.5 * e.val), Triplet::new(e.col, e.row, 0.5 * e.val)]
         })
         .collect();
-    let lu = solver.factor(&sym, 1.0, None).map_err(|e| ModalError::Singular(e.0))?;
+    let lu = solver.factor(&sym.into(), 1.0, None).map_err(|e| ModalError::Singular(e.0))?;
     let p = (2 * n).max(n + 8).min(nf);
     // deterministic start vectors
     let mut x = Mat::from_fn(nf, p, |i, j| {

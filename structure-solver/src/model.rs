@@ -6,6 +6,8 @@
 
 use faer::sparse::Triplet;
 
+pub use crate::linsolve::Tangent;
+
 /// A structure model: mass, constraints, internal and external forces and their tangent.
 pub trait Model: Send {
     /// Number of nodes; dofs are `6 * n_nodes()`.
@@ -47,12 +49,13 @@ pub trait Model: Send {
         }
     }
 
-    /// Consistent tangent (material + geometric) of internal minus external force, as triplets.
-    fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>);
+    /// Consistent tangent (material + geometric) of internal minus external force: element
+    /// blocks and loose entries, `out` emptied first.
+    fn tangent(&mut self, t: f64, out: &mut Tangent);
 
     /// A counter the model increases whenever its topology changes at run time (elements or
     /// constraints added, removed or duplicated): sparse solvers then check the pattern of the
-    /// tangent's triplet stream again. Constant (0) by default.
+    /// tangent's stream again. Constant (0) by default.
     fn topology_epoch(&self) -> u64 {
         0
     }

@@ -78,7 +78,7 @@ fn solve_tangent<const C: usize>(
     solver: &mut FreeSolver,
     rhs: [&[f64]; C],
 ) -> Result<[Vec<f64>; C], StaticsError> {
-    let mut trip = Vec::new();
+    let mut trip = crate::model::Tangent::default();
     model.tangent(t, &mut trip);
     let singular = |e: crate::linsolve::FactorError| StaticsError::Singular(e.0);
     solver.assemble(&trip, 1.0, None).map_err(singular)?;

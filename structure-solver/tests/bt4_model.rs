@@ -3,13 +3,13 @@
 //! shells driven directly by a minimal model (forces, mass, critical step and plastic state),
 //! and static and implicit solves refuse the model with a clear error.
 
-use faer::sparse::Triplet;
 use structure_solver::assembly::{Curve, FeModel, Part};
 use structure_solver::elements::bt4::{Bt4, Bt4Settings};
 use structure_solver::elements::{RotaryInertia, ShellSection, ShellYield};
 use structure_solver::material::{Elastic, ThicknessRule, J2};
 use structure_solver::mesh::generate;
 use structure_solver::model::Model;
+use structure_solver::model::Tangent;
 use structure_solver::statics::{load_steps, NewtonSettings, StaticsError};
 use structure_solver::time::{CentralDifference, Implicit, ImplicitError, ImplicitScheme};
 
@@ -79,7 +79,9 @@ impl Model for Bt4Only {
     fn external_force(&mut self, _t: f64, f: &mut [f64]) {
         f.fill(0.0);
     }
-    fn tangent(&mut self, _t: f64, _out: &mut Vec<Triplet<usize, usize, f64>>) {}
+    fn tangent(&mut self, _t: f64, out: &mut Tangent) {
+        out.clear();
+    }
     fn has_tangent(&self) -> bool {
         false
     }

@@ -10,10 +10,10 @@ use structure_solver::model::Model;
 
 fn assembled_dt(m: &mut FeModel) -> f64 {
     let n = m.n_dof();
-    let mut trip = Vec::new();
+    let mut trip = structure_solver::model::Tangent::default();
     m.tangent(0.0, &mut trip);
     let mut k = DMatrix::<f64>::zeros(n, n);
-    for t in &trip {
+    for t in trip.triplets() {
         k[(t.row, t.col)] += t.val;
     }
     let mass = m.lumped_mass();

@@ -11,7 +11,7 @@ use structure_solver::assembly::{Curve, FeModel, Part};
 use structure_solver::elements::ShellSection;
 use structure_solver::linsolve::FreeSolver;
 use structure_solver::mesh::generate::rectangle;
-use structure_solver::model::Model;
+use structure_solver::model::{Model, Tangent};
 use structure_solver::statics::{load_steps, NewtonSettings};
 use structure_solver::time::{Implicit, ImplicitScheme};
 
@@ -86,7 +86,9 @@ impl Model for Springs {
             f[6 * (self.n - 1) + c] = scale * self.f[c];
         }
     }
-    fn tangent(&mut self, _t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
+    fn tangent(&mut self, _t: f64, out: &mut Tangent) {
+        out.clear();
+        let out = &mut out.entries;
         for i in 1..self.n {
             for c in 0..6 {
                 let (a, b, k) = (6 * (i - 1) + c, 6 * i + c, self.stiffness(c));
@@ -289,15 +291,17 @@ fn the_scatter_map_assembles_the_triplet_paths_matrix_bit_for_bit() {
     let mut m = plate(6, 2e6);
     let mass = m.lumped_mass().to_vec();
     let mut solver = FreeSolver::new(&m);
-    let mut trip = Vec::new();
+    let mut trip = Tangent::default();
     let mut check = |m: &mut FeModel, solver: &mut FreeSolver, shuffle: bool| {
-        trip.clear();
         m.tangent(0.0, &mut trip);
         if shuffle {
-            trip.reverse();
+            // the element blocks as loose entries, last first
+            let mut entries: Vec<_> = trip.triplets().collect();
+            entries.reverse();
+            trip = Tangent::from(entries);
         }
         solver.assemble(&trip, 0.5, Some((3e7, &mass))).unwrap();
-        let want = triplet_path(solver, &trip, 0.5, (3e7, &mass));
+        let want = triplet_path(solver, &trip.triplets().collect::<Vec<_>>(), 0.5, (3e7, &mass));
         assert!(same_bits(solver.matrix().unwrap().val(), &want));
     };
     check(&mut m, &mut solver, false); // a new map
@@ -322,7 +326,7 @@ fn the_scatter_map_assembles_the_triplet_paths_matrix_bit_for_bit() {
 fn one_and_two_threads_solve_alike() {
     let mut m = plate(10, 1e5);
     let mass = m.lumped_mass().to_vec();
-    let mut trip = Vec::new();
+    let mut trip = Tangent::default();
     m.tangent(0.0, &mut trip);
     let mut f = vec![0.0; m.n_dof()];
     m.external_force(0.0, &mut f);

@@ -463,10 +463,10 @@ fn reduced_tangent_matches_finite_differences() {
     du[6 * master + 2] = 0.05;
     du[6 * master + 4] = 0.03;
     m.apply_increment(&du);
-    let mut trip = Vec::new();
+    let mut trip = structure_solver::model::Tangent::default();
     m.tangent(1.0, &mut trip);
     let mut k = vec![0.0; n * n];
-    for e in &trip {
+    for e in trip.triplets() {
         k[e.row * n + e.col] += e.val;
     }
     let g = |m: &mut FeModel| {

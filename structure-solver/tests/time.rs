@@ -3,7 +3,7 @@
 //! orders, energy conservation of the midpoint rule, the critical step.
 
 use faer::sparse::Triplet;
-use structure_solver::model::Model;
+use structure_solver::model::{Model, Tangent};
 use structure_solver::time::{
     critical_dt, kinetic_energy, CentralDifference, Implicit, ImplicitScheme,
 };
@@ -80,7 +80,9 @@ impl Model for Chain {
     fn external_force(&mut self, _t: f64, f: &mut [f64]) {
         f.fill(0.0);
     }
-    fn tangent(&mut self, _t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
+    fn tangent(&mut self, _t: f64, out: &mut Tangent) {
+        out.clear();
+        let out = &mut out.entries;
         out.push(Triplet::new(0, 0, self.k_ground));
         for i in 1..self.n {
             let d = self.u[6 * i] - self.u[6 * (i - 1)];

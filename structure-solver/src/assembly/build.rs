@@ -127,7 +127,6 @@ impl FeModel {
             external: vec![0.0; 6 * nn],
             held_extra: vec![],
             scratch: vec![],
-            tangent_values: vec![],
             element_bound: vec![],
             topology,
         };

@@ -2,7 +2,7 @@
 //! and skew symmetry planes (a linear constraint per node, reduced as `Tᵀ f`, `Tᵀ K T`,
 //! `Tᵀ M T`, increments expanded by `T`).
 
-use faer::sparse::Triplet;
+use crate::linsolve::{Expansion, Tangent, MAX_EXPANSION};
 use nalgebra::{Matrix3, Vector3};
 
 use super::{AssemblyError, Curve, FeModel};
@@ -223,10 +223,10 @@ impl FeModel {
 
     /// `K ← Tᵀ K T` on triplets at the skew symmetry nodes (`T` is constant: no geometric
     /// term).
-    pub(super) fn reduce_skew_tangent(&self, k: &mut Vec<Triplet<usize, usize, f64>>) {
-        let expand = |d: usize| -> ([(usize, f64); 3], usize) {
+    pub(super) fn reduce_skew_tangent(&self, k: &mut Tangent) {
+        let expand = |d: usize| -> Expansion {
             let (n, c) = (d / 6, d % 6);
-            let mut out = [(d, 1.0); 3];
+            let mut out = [(d, 1.0); MAX_EXPANSION];
             let Some(s) = self.skew_of[n] else { return (out, 1) };
             let t = &self.skew[s].t;
             let mut len = 0;
@@ -238,21 +238,7 @@ impl FeModel {
             }
             (out, len)
         };
-        let mut out = Vec::with_capacity(k.len());
-        for e in k.iter() {
-            if self.skew_of[e.row / 6].is_none() && self.skew_of[e.col / 6].is_none() {
-                out.push(*e);
-                continue;
-            }
-            let (rows, nr) = expand(e.row);
-            let (cols, nc) = expand(e.col);
-            for &(i, a) in &rows[..nr] {
-                for &(j, b) in &cols[..nc] {
-                    out.push(Triplet::new(i, j, a * e.val * b));
-                }
-            }
-        }
-        *k = out;
+        k.reduce(|d| self.skew_of[d / 6].is_some(), expand);
     }
 
     /// Prescribes dof `c` of `nodes` to `value · curve(t)`.

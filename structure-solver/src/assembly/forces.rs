@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::loads::pressure_force;
 use super::{gather, FeModel};
-use crate::model::Model;
+use crate::model::{Model, Tangent};
 
 impl Model for FeModel {
     fn n_nodes(&self) -> usize {
@@ -113,7 +113,7 @@ impl Model for FeModel {
     }
 
     /// Tangent of internal minus external force, reduced by the rigid bodies.
-    fn tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
+    fn tangent(&mut self, t: f64, out: &mut Tangent) {
         self.element_tangent(t, out);
         self.spring_tangent(out);
         if !self.rigid.is_empty() {
@@ -285,86 +285,31 @@ impl FeModel {
         }
     }
 
-    /// The tangent of the elements; explicit shells add nothing (`has_tangent` is then `false`).
-    pub(super) fn element_tangent(&mut self, t: f64, out: &mut Vec<Triplet<usize, usize, f64>>) {
+    /// The tangent of the elements, one block each, computed in parallel in place; explicit
+    /// shells add nothing (`has_tangent` is then `false`).
+    pub(super) fn element_tangent(&mut self, t: f64, out: &mut Tangent) {
         out.clear();
         let pc = self.cell_pressure(t);
         let pe: Vec<f64> = self.element_cell.iter().map(|&c| pc[c]).collect();
-        let size = |e: &crate::elements::Element| (6 * e.nodes.len()).pow(2);
-        let total = self.elements.iter().map(size).sum();
-        let mut values = std::mem::take(&mut self.tangent_values);
-        values.resize(total, 0.0);
-        let mut blocks = Vec::with_capacity(self.elements.len());
-        let mut rest = &mut values[..];
-        for e in &self.elements {
-            let (head, tail) = rest.split_at_mut(size(e));
-            blocks.push(head);
-            rest = tail;
-        }
+        let dofs = self
+            .elements
+            .iter()
+            .map(|e| e.nodes.iter().flat_map(|&n| (0..6).map(move |c| 6 * n + c)));
+        let mut blocks = out.set_blocks(dofs);
         let s = &self.trial;
         let committed = &self.committed.material;
-        let counts: Vec<usize> = blocks
-            .par_iter_mut()
-            .zip(&self.elements)
-            .enumerate()
-            .map(|(ei, (block, e))| {
-                let x = gather(&s.x, &e.nodes);
-                let r = gather(&s.r, &e.nodes);
-                let st = &committed[self.state_offsets[ei]..self.state_offsets[ei + 1]];
-                let k = if pe[ei] != 0.0 {
-                    let p = pe[ei];
-                    let load = move |xs: &[Vector3<f64>], o: &mut [f64]| pressure_force(p, xs, o);
-                    e.tangent(&x, &r, st, Some(&load))
-                } else {
-                    e.tangent(&x, &r, st, None)
-                };
-                block.copy_from_slice(k.as_slice());
-                k.iter().filter(|&&v| v != 0.0).count()
-            })
-            .collect();
-        push_blocks(&self.elements, &blocks, &counts, out);
-        self.tangent_values = values;
+        blocks.par_iter_mut().zip(&self.elements).enumerate().for_each(|(ei, (block, e))| {
+            let x = gather(&s.x, &e.nodes);
+            let r = gather(&s.r, &e.nodes);
+            let st = &committed[self.state_offsets[ei]..self.state_offsets[ei + 1]];
+            let k = if pe[ei] != 0.0 {
+                let p = pe[ei];
+                let load = move |xs: &[Vector3<f64>], o: &mut [f64]| pressure_force(p, xs, o);
+                e.tangent(&x, &r, st, Some(&load))
+            } else {
+                e.tangent(&x, &r, st, None)
+            };
+            block.copy_from_slice(k.as_slice());
+        });
     }
-}
-
-/// Appends the nonzero entries of each element matrix `blocks[e]` (column-major, on the dofs
-/// of `elements[e]`'s nodes; `counts[e]` of them nonzero) to `out`, element by element in
-/// row-major order within each: the stream of a serial loop, written in parallel into the
-/// slices the counts give each element.
-fn push_blocks(
-    elements: &[crate::elements::Element],
-    blocks: &[&mut [f64]],
-    counts: &[usize],
-    out: &mut Vec<Triplet<usize, usize, f64>>,
-) {
-    let total: usize = counts.iter().sum();
-    out.reserve(total);
-    let mut chunks = Vec::with_capacity(counts.len());
-    let mut rest = &mut out.spare_capacity_mut()[..total];
-    for &c in counts {
-        let (head, tail) = rest.split_at_mut(c);
-        chunks.push(head);
-        rest = tail;
-    }
-    chunks.into_par_iter().zip(elements).zip(blocks).with_min_len(64).for_each(
-        |((chunk, e), k)| {
-            let n = 6 * e.nodes.len();
-            let dof = |a: usize| 6 * e.nodes[a / 6] + a % 6;
-            let mut written = 0;
-            for a in 0..n {
-                let da = dof(a);
-                for b in 0..n {
-                    let v = k[a + n * b];
-                    if v != 0.0 {
-                        chunk[written].write(Triplet::new(da, dof(b), v));
-                        written += 1;
-                    }
-                }
-            }
-            assert_eq!(written, chunk.len(), "an element matrix changed while it was read");
-        },
-    );
-    // SAFETY: the chunks partition the first `total` spare slots and each chunk was written
-    // whole (asserted above; a panic there propagates before this line).
-    unsafe { out.set_len(out.len() + total) };
 }

@@ -169,9 +169,6 @@ pub struct FeModel {
     held_extra: Vec<f64>,
     /// Work arrays of the element force loop.
     scratch: Vec<element_forces::ElementScratch>,
-    /// The element tangents of the last `Model::tangent`, one after another (kept: fresh
-    /// pages each Newton iteration cost more than copying into these).
-    tangent_values: Vec<f64>,
     /// Each element's bound of the critical step at the reference configuration.
     element_bound: Vec<stable_step::ElementBound>,
     /// User ids of nodes and cells, where each cell's element is stored, the version.

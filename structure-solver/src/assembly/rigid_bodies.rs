@@ -6,6 +6,7 @@ use faer::sparse::Triplet;
 use nalgebra::{Matrix3, Vector3};
 
 use super::FeModel;
+use crate::linsolve::{Expansion, Tangent, MAX_EXPANSION};
 use crate::model::Model;
 use crate::rigid::{ExtraMass, RigidBody, RigidError, RigidReference};
 
@@ -144,7 +145,7 @@ impl FeModel {
     /// `K ← Tᵀ K T` on triplets, plus the geometric term of the rotating offsets
     /// `Σ_s [g_s]× [r_s]×` on the master's rotations (`g_s` the slave's internal minus external
     /// force, `r_s = x_s - x_m`).
-    pub(super) fn reduce_tangent(&mut self, t: f64, k: &mut Vec<Triplet<usize, usize, f64>>) {
+    pub(super) fn reduce_tangent(&mut self, t: f64, k: &mut Tangent) {
         use crate::elements::rotation::spin;
         if !self.fint_valid {
             let mut f = vec![0.0; self.n_dof()];
@@ -161,15 +162,15 @@ impl FeModel {
             }
         }
         // column d of T: (reduced dof, coefficient) pairs
-        let expand = |d: usize| -> ([(usize, f64); 4], usize) {
+        let expand = |d: usize| -> Expansion {
             let (n, c) = (d / 6, d % 6);
             match link[n] {
-                None => ([(d, 1.0); 4], 1),
-                Some((m, _)) if c >= 3 => ([(6 * m + c, 1.0); 4], 1),
+                None => ([(d, 1.0); MAX_EXPANSION], 1),
+                Some((m, _)) if c >= 3 => ([(6 * m + c, 1.0); MAX_EXPANSION], 1),
                 Some((m, r)) => {
                     // δu_s = δu_m - [r]× δθ_m
                     let s = -spin(&r);
-                    let mut out = [(6 * m + c, 1.0); 4];
+                    let mut out = [(6 * m + c, 1.0); MAX_EXPANSION];
                     let mut len = 1;
                     for j in 0..3 {
                         if s[(c, j)] != 0.0 {
@@ -181,20 +182,7 @@ impl FeModel {
                 }
             }
         };
-        let mut out = Vec::with_capacity(k.len());
-        for e in k.iter() {
-            if link[e.row / 6].is_none() && link[e.col / 6].is_none() {
-                out.push(*e);
-                continue;
-            }
-            let (rows, nr) = expand(e.row);
-            let (cols, nc) = expand(e.col);
-            for &(i, a) in &rows[..nr] {
-                for &(j, b) in &cols[..nc] {
-                    out.push(Triplet::new(i, j, a * e.val * b));
-                }
-            }
-        }
+        k.reduce(|d| link[d / 6].is_some(), expand);
         for (s, l) in link.iter().enumerate() {
             if let Some((m, r)) = l {
                 let g = Vector3::from_fn(|c, _| self.fint_full[6 * s + c] - fext[6 * s + c]);
@@ -202,12 +190,12 @@ impl FeModel {
                 for i in 0..3 {
                     for j in 0..3 {
                         if gr[(i, j)] != 0.0 {
-                            out.push(Triplet::new(6 * m + 3 + i, 6 * m + 3 + j, gr[(i, j)]));
+                            let e = Triplet::new(6 * m + 3 + i, 6 * m + 3 + j, gr[(i, j)]);
+                            k.entries.push(e);
                         }
                     }
                 }
             }
         }
-        *k = out;
     }
 }

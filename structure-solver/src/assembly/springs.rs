@@ -8,6 +8,8 @@
 //! constrained dofs held), so `ω = sqrt(k/m)` for a body of mass `m` on one axis.
 
 use faer::sparse::Triplet;
+
+use crate::linsolve::Tangent;
 use nalgebra::{Matrix3, SymmetricEigen};
 
 use super::FeModel;
@@ -70,11 +72,11 @@ impl FeModel {
     }
 
     /// Adds `K` of every spring to the tangent (unreduced).
-    pub(super) fn spring_tangent(&self, out: &mut Vec<Triplet<usize, usize, f64>>) {
+    pub(super) fn spring_tangent(&self, out: &mut Tangent) {
         for s in &self.springs {
             for (i, &k) in s.stiffness.iter().enumerate() {
                 if k != 0.0 {
-                    out.push(Triplet::new(6 * s.node + i, 6 * s.node + i, k));
+                    out.entries.push(Triplet::new(6 * s.node + i, 6 * s.node + i, k));
                 }
             }
         }

@@ -234,13 +234,18 @@ impl Factor {
     /// Solves `J x = b` (`transpose`: `Jᵀ x = b`). A reused factor runs one GMRES cycle and
     /// gives `x: None` if that does not converge; a fresh one runs `FRESH` and falls back to
     /// the LU of `J`.
-    pub(super) fn solve_vec(&self, b: &[f64], transpose: bool) -> Result<Outcome, FactorError> {
+    pub(super) fn solve_vec(
+        &self,
+        b: &[f64],
+        transpose: bool,
+        tol: f64,
+    ) -> Result<Outcome, FactorError> {
         let out = match &self.ldlt {
             Some(m) if !self.fresh => {
                 let one = Limits { restart: FRESH.restart, cycles: 1 };
-                return Ok(gmres::solve(&self.j, m, b, transpose, one));
+                return Ok(gmres::solve(&self.j, m, b, transpose, one, tol));
             }
-            Some(m) => gmres::solve(&self.j, m, b, transpose, FRESH),
+            Some(m) => gmres::solve(&self.j, m, b, transpose, FRESH, tol),
             None => Outcome { x: None, iterations: 0 },
         };
         if out.x.is_some() || !self.fresh {
@@ -261,7 +266,7 @@ impl Factor {
         let n = rhs.nrows();
         for c in 0..rhs.ncols() {
             let b: Vec<f64> = (0..n).map(|i| rhs[(i, c)]).collect();
-            let x = match self.solve_vec(&b, transpose) {
+            let x = match self.solve_vec(&b, transpose, super::SOLVE_TOL) {
                 Ok(Outcome { x: Some(x), .. }) => x,
                 // SolveCore cannot return an error: a failed solve gives NaN, which every
                 // caller's finite check reports

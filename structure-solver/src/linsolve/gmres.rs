@@ -3,10 +3,8 @@
 //! `J S⁻¹ y = b`, `x = S⁻¹ y`, Givens rotations on the Hessenberg matrix.
 
 use super::factor::{Jacobian, Ldlt};
-use super::SOLVE_TOL;
-
 /// Backward error `|b - J x| / (|J|₁ |x|)` accepted as converged (what a direct solve of an
-/// ill-conditioned matrix gives) when the relative residual cannot reach `SOLVE_TOL`.
+/// ill-conditioned matrix gives) when the relative residual cannot reach the tolerance.
 const BACKWARD_TOL: f64 = 1e-14;
 
 /// Krylov vectors per cycle and cycles.
@@ -27,10 +25,17 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Solves `J x = b` (`transpose`: `Jᵀ x = b`) to a relative residual of `SOLVE_TOL` (or the
+/// Solves `J x = b` (`transpose`: `Jᵀ x = b`) to a relative residual of `tol` (or the
 /// backward error `BACKWARD_TOL`). A symmetric `J` starts from `x = S⁻¹ b` (exact when `S`
 /// is the factor of this `J`: one iteration); otherwise from 0.
-pub(super) fn solve(j: &Jacobian, m: &Ldlt, b: &[f64], transpose: bool, lim: Limits) -> Outcome {
+pub(super) fn solve(
+    j: &Jacobian,
+    m: &Ldlt,
+    b: &[f64],
+    transpose: bool,
+    lim: Limits,
+    tol: f64,
+) -> Outcome {
     let n = b.len();
     let bn = norm(b);
     let mut x = vec![0.0; n];
@@ -51,7 +56,7 @@ pub(super) fn solve(j: &Jacobian, m: &Ldlt, b: &[f64], transpose: bool, lim: Lim
     }
     let converged = |r: &[f64], x: &[f64]| {
         let rn = norm(r);
-        rn <= SOLVE_TOL * bn || rn <= BACKWARD_TOL * j.norm1 * norm(x)
+        rn <= tol * bn || rn <= BACKWARD_TOL * j.norm1 * norm(x)
     };
     for _ in 0..lim.cycles {
         if converged(&r, &x) {
@@ -95,7 +100,7 @@ pub(super) fn solve(j: &Jacobian, m: &Ldlt, b: &[f64], transpose: bool, lim: Lim
             g[k] *= c;
             h.push(hk);
             z.push(zk);
-            if g[k + 1].abs() <= 0.1 * SOLVE_TOL * bn || wn == 0.0 {
+            if g[k + 1].abs() <= 0.1 * tol * bn || wn == 0.0 {
                 break;
             }
             v.push(w.iter().map(|wl| wl / wn).collect());

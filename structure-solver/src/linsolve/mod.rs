@@ -1,7 +1,8 @@
 //! The sparse solve of Newton iterations on the free dofs of a [`Model`] (DESIGN §6, faer).
 //!
 //! - `free_dofs`: the free-dof numbering, gather and scatter between full and free vectors.
-//! - `scatter`: triplets into compressed columns through a precomputed slot per triplet.
+//! - `scatter`: a stream of entries into compressed columns through a precomputed slot per
+//!   entry.
 //! - `pattern`: the structurally symmetric pattern (the full 6x6 node blocks of the tangent's
 //!   entries, every diagonal entry) made on the first call with its fill-reducing ordering
 //!   (AMD on the nodes) and symbolic `LDLᵀ`; later calls redo only the numeric work.
@@ -13,7 +14,10 @@
 //!   faer's sparse LU, whose COLAMD ordering and partial pivoting make far more fill). Where
 //!   `S` has a zero pivot or GMRES stalls, faer's LU with partial pivoting of `J` itself.
 //! - `gmres`: `J x = b` right-preconditioned with an `LDLᵀ` to a relative residual of
-//!   `SOLVE_TOL` (one step when the skew part is small against `S`, as in shells and beams).
+//!   `SOLVE_TOL`, or to the looser [`forcing`] of an inexact Newton iteration (one step when
+//!   the skew part is small against `S`, as in shells and beams).
+//! - `tangent`: the matrix as the model emits it, dense element blocks written in place and
+//!   loose entries; `scatter` sums them into the slots (no triplet per element entry).
 //!
 //! [`FreeSolver`] keeps the last `LDLᵀ` and preconditions the GMRES of later matrices with it
 //! (the next Newton iterations, the next time or load steps) while that converges within
@@ -25,10 +29,11 @@ mod free_dofs;
 mod gmres;
 mod pattern;
 pub mod scatter;
+mod tangent;
 
 use std::sync::Arc;
 
-use faer::sparse::{SparseColMatRef, Triplet};
+use faer::sparse::SparseColMatRef;
 use faer::MatMut;
 
 pub use factor::Factor;
@@ -36,12 +41,35 @@ use factor::{Jacobian, Ldlt};
 pub use free_dofs::FreeDofs;
 use pattern::Pattern;
 pub use scatter::{Fingerprint, ScatterMap, SparsePattern};
+pub use tangent::{Expansion, Tangent, MAX_EXPANSION};
 
 use crate::model::Model;
 
 /// Relative residual `|b - J x| / |b|` the solve reaches, or else a backward error
 /// `|b - J x| / (|J|₁ |x|)` of 1e-14 (what a direct solve of an ill-conditioned matrix gives).
 pub const SOLVE_TOL: f64 = 1e-11;
+
+/// Largest relative residual [`forcing`] asks of a Newton iteration's solve.
+const FORCING_MAX: f64 = 1e-2;
+
+/// Relative residual of the linear solve of a Newton iteration (inexact Newton, Eisenstat &
+/// Walker 1996, their choice 2 with γ = 0.9, α = 2): `η = 0.9 (|r_k| / |r_{k-1}|)²`, at most
+/// `FORCING_MAX` (and that on the first iteration, `previous: None`), never below what the
+/// Newton `target` needs (`0.1 target / |r_k|`: no solve goes further than a tenth of the
+/// tolerance, which would be oversolving) nor below `SOLVE_TOL`. A solve to `η` leaves a linear
+/// residual `η |r_k|`; the quadratic part of Newton's error dominates it while `η` follows the
+/// observed contraction. Where the residual has not halved, Newton is outside its quadratic
+/// range (large rotations) and an inexact step can send it astray: that solve goes to the
+/// floor.
+pub fn forcing(residual: f64, previous: Option<f64>, target: f64) -> f64 {
+    let floor = (0.1 * target / residual).max(SOLVE_TOL);
+    let ew = match previous {
+        None => FORCING_MAX,
+        Some(p) if residual <= 0.5 * p => 0.9 * (residual / p).powi(2),
+        Some(_) => return floor,
+    };
+    ew.min(FORCING_MAX).max(floor)
+}
 
 /// GMRES iterations (preconditioner applications) a kept factor may take on one right-hand
 /// side before the next solve refactors.
@@ -169,12 +197,15 @@ impl FreeSolver {
     /// Makes the pattern and scatter map fit the triplet stream `k`: the map is kept when the
     /// stream passes its spot check (its full fingerprint after a topology change), the
     /// pattern when it holds every entry.
-    fn fit(&mut self, k: &[Triplet<usize, usize, f64>]) -> Result<(), FactorError> {
+    fn fit(&mut self, k: &Tangent) -> Result<(), FactorError> {
         let free = &self.free;
-        let index = |t: usize| Some((free.index(k[t].row)?, free.index(k[t].col)?));
+        let index = |t: usize| {
+            let (i, j) = k.index(t);
+            Some((free.index(i)?, free.index(j)?))
+        };
         if let (Some(p), Some(m)) = (&self.pattern, &self.map) {
             let same = if self.recheck {
-                Fingerprint::of_triplets(k) == m.fingerprint()
+                Fingerprint::of_tangent(k) == m.fingerprint()
             } else {
                 m.spot_check(&p.col_ptr, &p.row_idx, k.len(), index)
             };
@@ -182,14 +213,14 @@ impl FreeSolver {
             if same {
                 return Ok(());
             }
-            let fp = Fingerprint::of_triplets(k);
+            let fp = Fingerprint::of_tangent(k);
             if let Ok(m) = ScatterMap::onto(&p.col_ptr, &p.row_idx, k.len(), index, fp) {
                 self.map = Some(Arc::new(m));
                 return Ok(());
             }
         }
         let p = Pattern::covering(free, k, self.pattern.as_deref()).map_err(FactorError)?;
-        let fp = Fingerprint::of_triplets(k);
+        let fp = Fingerprint::of_tangent(k);
         let m = ScatterMap::onto(&p.col_ptr, &p.row_idx, k.len(), index, fp)?;
         self.map = Some(Arc::new(m));
         self.pattern = Some(Arc::new(p));
@@ -202,7 +233,7 @@ impl FreeSolver {
     /// triplets `k` (entries on constrained dofs dropped, duplicates summed in order).
     fn jacobian(
         &mut self,
-        k: &[Triplet<usize, usize, f64>],
+        k: &Tangent,
         ck: f64,
         mass: Option<(f64, &[f64])>,
     ) -> Result<Jacobian, FactorError> {
@@ -211,7 +242,7 @@ impl FreeSolver {
             return Err(FactorError("no matrix pattern".into()));
         };
         let mut a = pattern.take_any(pattern.nnz()); // every slot written
-        map.scatter_with(|t| ck * k[t].val, &mut a);
+        map.scatter_with(|t| ck * k.value(t), &mut a);
         if let Some((cm, m)) = mass {
             for (d, &mi) in m.iter().enumerate() {
                 if let Some(i) = self.free.index(d) {
@@ -226,7 +257,7 @@ impl FreeSolver {
     /// factoring it.
     pub fn assemble(
         &mut self,
-        k: &[Triplet<usize, usize, f64>],
+        k: &Tangent,
         ck: f64,
         mass: Option<(f64, &[f64])>,
     ) -> Result<(), FactorError> {
@@ -244,7 +275,18 @@ impl FreeSolver {
     /// [`Self::assemble`]: GMRES preconditioned with the kept factor while it converges within
     /// a cycle (one that needs more than `REUSE_ITERATIONS` is replaced at the next solve),
     /// else with a new factorisation of `J`, which is kept.
-    pub fn solve_in_place(&mut self, mut rhs: MatMut<'_, f64>) -> Result<(), FactorError> {
+    pub fn solve_in_place(&mut self, rhs: MatMut<'_, f64>) -> Result<(), FactorError> {
+        self.solve_in_place_to(rhs, SOLVE_TOL)
+    }
+
+    /// [`Self::solve_in_place`] to the relative residual `tol` (at least `SOLVE_TOL`; a
+    /// Newton iteration's [`forcing`]).
+    pub fn solve_in_place_to(
+        &mut self,
+        mut rhs: MatMut<'_, f64>,
+        tol: f64,
+    ) -> Result<(), FactorError> {
+        let tol = tol.max(SOLVE_TOL);
         let Some(f) = self.current.as_mut() else {
             return Err(FactorError("no matrix assembled before the solve".into()));
         };
@@ -261,7 +303,7 @@ impl FreeSolver {
             let kept = self.kept.as_ref().filter(|m| m.is_on(&f.jacobian().pattern));
             if let (false, true, false, Some(kept)) = (f.is_fresh(), self.reuse, self.stale, kept) {
                 f.reuse(Arc::clone(kept));
-                let out = f.solve_vec(&b, false)?;
+                let out = f.solve_vec(&b, false, tol)?;
                 self.stats.gmres_iterations += out.iterations;
                 self.stale = out.iterations > REUSE_ITERATIONS || out.x.is_none();
                 x = out.x;
@@ -275,7 +317,7 @@ impl FreeSolver {
                         self.kept = f.fresh_ldlt().cloned();
                         self.stale = false;
                     }
-                    let out = f.solve_vec(&b, false)?;
+                    let out = f.solve_vec(&b, false, tol)?;
                     self.stats.gmres_iterations += out.iterations;
                     out.x.ok_or_else(|| {
                         FactorError("the solve of the free-dof matrix did not converge".into())
@@ -294,7 +336,7 @@ impl FreeSolver {
     /// solves through faer's `Solve`; the kept factor is left alone.
     pub fn factor(
         &mut self,
-        k: &[Triplet<usize, usize, f64>],
+        k: &Tangent,
         ck: f64,
         mass: Option<(f64, &[f64])>,
     ) -> Result<Factor, FactorError> {
@@ -302,5 +344,24 @@ impl FreeSolver {
         f.refactor()?;
         self.stats.factorisations += 1;
         Ok(f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn forcing_follows_the_contraction_between_its_bounds() {
+        let target = 1e-8;
+        // first iteration far from the tolerance: the loosest solve
+        assert_eq!(forcing(1.0, None, target), FORCING_MAX);
+        // quadratic contraction: 0.9 (r_k / r_{k-1})²
+        assert!((forcing(1e-3, Some(1e-1), target) - 0.9e-4).abs() < 1e-18);
+        // near the tolerance: a tenth of the target, no further
+        assert!((forcing(1e-6, Some(1e-3), target) - 1e-3).abs() < 1e-15);
+        // a residual that did not halve: to the floor
+        assert!((forcing(0.6, Some(1.0), target) - (0.1 * target / 0.6)).abs() < 1e-20);
+        assert_eq!(forcing(1e9, Some(1e9), target), SOLVE_TOL);
     }
 }

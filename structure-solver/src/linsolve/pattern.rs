@@ -10,11 +10,11 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, SymbolicCholesky, SymmetricOrdering,
 };
 use faer::sparse::linalg::solvers::SymbolicLu;
-use faer::sparse::{SymbolicSparseColMatRef, Triplet};
+use faer::sparse::SymbolicSparseColMatRef;
 use faer::Side;
 use rayon::prelude::*;
 
-use super::FreeDofs;
+use super::{FreeDofs, Tangent};
 
 /// A structurally symmetric sparse pattern (sorted rows, every diagonal entry present) and its
 /// symbolic `LDLᵀ`.
@@ -89,12 +89,9 @@ impl Pattern {
     /// A pattern holding the free entries of `k` and of `old`: the full 6x6 node blocks of
     /// `k`'s entries, so that entries zero in the first tangent (a flat initial geometry) and
     /// nonzero later do not force a new analysis.
-    pub fn covering(
-        free: &FreeDofs,
-        k: &[Triplet<usize, usize, f64>],
-        old: Option<&Pattern>,
-    ) -> Result<Self, String> {
-        let mut blocks: Vec<(usize, usize)> = k.iter().map(|e| (e.row / 6, e.col / 6)).collect();
+    pub fn covering(free: &FreeDofs, k: &Tangent, old: Option<&Pattern>) -> Result<Self, String> {
+        let mut blocks: Vec<(usize, usize)> =
+            k.triplets().map(|e| (e.row / 6, e.col / 6)).collect();
         blocks.sort_unstable();
         blocks.dedup();
         let new = blocks.iter().flat_map(|&(a, b)| {

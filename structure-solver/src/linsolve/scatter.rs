@@ -5,7 +5,7 @@
 //! in emission order, so the values are bitwise those of the serial sum `a[slot(k)] += v_k`
 //! over `k = 0, 1, …`, whatever the thread count.
 
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef, Triplet};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 
 use super::FactorError;
@@ -46,9 +46,9 @@ impl Fingerprint {
         Fingerprint { count, hash }
     }
 
-    /// The fingerprint of the indices of `k`.
-    pub fn of_triplets(k: &[Triplet<usize, usize, f64>]) -> Self {
-        Fingerprint::of(k.len(), |t| (k[t].row, k[t].col))
+    /// The fingerprint of the indices of the stream `k`.
+    pub fn of_tangent(k: &super::Tangent) -> Self {
+        Fingerprint::of(k.len(), |t| k.index(t))
     }
 }
 
@@ -261,7 +261,7 @@ impl SparsePattern {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::sparse::SparseColMat;
+    use faer::sparse::{SparseColMat, Triplet};
 
     /// A pseudo-random stream with many duplicates, out of order.
     fn stream(n: usize, len: usize) -> (Vec<(usize, usize)>, Vec<f64>) {

@@ -4,8 +4,6 @@
 //! `ω_max² <= max_i Σ_j |K_ij| / sqrt(m_i m_j)` which never overestimates the step; and the
 //! rule that recomputes the step every step from the element bound ([`StableStep`]).
 
-use faer::sparse::Triplet;
-
 use crate::model::Model;
 
 /// The three estimates of the critical step.
@@ -68,7 +66,7 @@ impl StableStep {
 /// mass only, increments of at most `probe` in any dof). The model is reverted afterwards.
 pub fn critical_dt(model: &mut dyn Model, t: f64, iterations: usize, probe: f64) -> CriticalDt {
     let n = model.n_dof();
-    let mut k: Vec<Triplet<usize, usize, f64>> = Vec::new();
+    let mut k = crate::model::Tangent::default();
     model.tangent(t, &mut k);
     let m = model.lumped_mass().to_vec();
     let free: Vec<bool> =
@@ -76,7 +74,7 @@ pub fn critical_dt(model: &mut dyn Model, t: f64, iterations: usize, probe: f64)
     let inv_sqrt: Vec<f64> =
         m.iter().zip(&free).map(|(&m, &f)| if f { 1.0 / m.sqrt() } else { 0.0 }).collect();
     let mut rows = vec![0.0; n];
-    for e in &k {
+    for e in k.triplets() {
         rows[e.row] += (e.val * inv_sqrt[e.row] * inv_sqrt[e.col]).abs();
     }
     let bound = rows.iter().cloned().fold(0.0, f64::max);

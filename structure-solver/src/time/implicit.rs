@@ -1,6 +1,7 @@
 //! Implicit steps with Newton and a sparse solve on the free dofs (`linsolve`: GMRES
 //! preconditioned with an `LDLᵀ` factor kept across Newton iterations and steps while it
-//! converges within `REUSE_ITERATIONS`, refactored otherwise):
+//! converges within `REUSE_ITERATIONS`, refactored otherwise; each solve only as accurate as
+//! Newton's convergence needs, `linsolve::forcing`):
 //!
 //! - **Newmark, average acceleration** (β = 1/4, γ = 1/2; Newmark 1959): unknown `Δu`,
 //!   `a^{n+1} = 4/Δt² (Δu - Δt v^n) - a^n`, `v^{n+1} = v^n + Δt/2 (a^n + a^{n+1})`, residual
@@ -21,8 +22,8 @@
 use faer::sparse::Triplet;
 
 use super::{out_of_balance, prescribed_increment, Dynamics};
-use crate::linsolve::{FreeSolver, SolveStats};
-use crate::model::Model;
+use crate::linsolve::{forcing, FreeSolver, SolveStats, SOLVE_TOL};
+use crate::model::{Model, Tangent};
 
 /// Which implicit rule.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,6 +41,10 @@ pub struct NewtonParams {
     /// Absolute floor of the residual norm (forces), for states at rest.
     pub abs_tol: f64,
     pub max_iter: usize,
+    /// Each linear solve goes only as far as Newton's convergence needs (`linsolve::forcing`);
+    /// `false`: every solve to `SOLVE_TOL`, so that runs whose matrices differ in round-off
+    /// (another dof numbering, added dofs) follow the same Newton iterates to round-off.
+    pub inexact: bool,
 }
 
 /// How far above the tolerance a residual that has stopped falling is accepted as round-off.
@@ -47,7 +52,7 @@ const STALL_FACTOR: f64 = 100.0;
 
 impl Default for NewtonParams {
     fn default() -> Self {
-        NewtonParams { tol: 1e-10, abs_tol: 1e-12, max_iter: 25 }
+        NewtonParams { tol: 1e-10, abs_tol: 1e-12, max_iter: 25, inexact: true }
     }
 }
 
@@ -88,7 +93,8 @@ pub struct Implicit {
     /// Acceleration implied by `Δu` and the inertia force `M` times it.
     acc: Vec<f64>,
     inertia: Vec<f64>,
-    triplets: Vec<Triplet<usize, usize, f64>>,
+    /// Boxed: five arrays.
+    tangent: Box<Tangent>,
     mass_triplets: Vec<Triplet<usize, usize, f64>>,
 }
 
@@ -125,7 +131,7 @@ impl Implicit {
             scratch: vec![0.0; n],
             acc: vec![0.0; n],
             inertia: vec![0.0; n],
-            triplets: Vec::new(),
+            tangent: Box::default(),
             mass_triplets: Vec::new(),
         }
     }
@@ -248,6 +254,7 @@ impl Implicit {
             // Newton has reached the round-off floor of the forces when a further iteration no
             // longer halves the residual: accept that floor within `STALL_FACTOR` x the tolerance.
             let stalled = rn > 0.5 * last.0 && rn <= STALL_FACTOR * self.params.tol * reference;
+            let previous = (it > 0).then_some(last.0);
             last = (rn, reference);
             if rn <= self.params.tol * reference || rn <= self.params.abs_tol || stalled {
                 self.finish(model, dt, stage);
@@ -263,18 +270,19 @@ impl Implicit {
                 break;
             }
             // Jacobian cm M + ck K on the free dofs; solve J δ = r (r = -residual).
-            self.triplets.clear();
-            model.tangent(t_load, &mut self.triplets);
+            model.tangent(t_load, &mut self.tangent);
             model.nondiagonal_mass(&mut self.mass_triplets);
             let scale = cm / ck;
-            self.triplets.extend(
+            self.tangent.entries.extend(
                 self.mass_triplets.iter().map(|e| Triplet::new(e.row, e.col, scale * e.val)),
             );
             let mut sol = self.solver.free.gather(&self.r);
+            let target = (self.params.tol * reference).max(self.params.abs_tol);
+            let eta = if self.params.inexact { forcing(rn, previous, target) } else { SOLVE_TOL };
             let solved = self
                 .solver
-                .assemble(&self.triplets, ck, Some((cm, &mass)))
-                .and_then(|()| self.solver.solve_in_place(sol.as_mut()));
+                .assemble(&self.tangent, ck, Some((cm, &mass)))
+                .and_then(|()| self.solver.solve_in_place_to(sol.as_mut(), eta));
             if let Err(e) = solved {
                 model.revert();
                 return Err(ImplicitError::Singular(e.0));
