@@ -288,7 +288,7 @@ impl FeModel {
     /// The tangent of the elements, one block each, computed in parallel in place; explicit
     /// shells add nothing (`has_tangent` is then `false`).
     pub(super) fn element_tangent(&mut self, t: f64, out: &mut Tangent) {
-        out.clear();
+        out.entries.clear(); // the blocks are all replaced
         let pc = self.cell_pressure(t);
         let pe: Vec<f64> = self.element_cell.iter().map(|&c| pc[c]).collect();
         let dofs = self

@@ -167,7 +167,7 @@ impl Reference {
                     let txx = -tinv[i] * f.gx[j];
                     let txr = tinv[i] * (et * kron - f.gr[j]);
                     for (bi, bj, m) in [(0, 0, uxx), (0, 3, uxr), (3, 0, txx), (3, 3, txr)] {
-                        bm.view_mut((6 * i + bi, 6 * j + bj), (3, 3)).copy_from(&m);
+                        bm.fixed_view_mut::<3, 3>(6 * i + bi, 6 * j + bj).copy_from(&m);
                     }
                 }
             }
@@ -246,15 +246,21 @@ impl Reference {
         let e = fr.e;
         let et = e.transpose();
         let v3 = |s: &[f64], o: usize| Vector3::new(s[o], s[o + 1], s[o + 2]);
-        let mut g = DMatrix::zeros(3, size);
-        for j in 0..n {
-            g.fixed_view_mut::<3, 3>(0, 6 * j).copy_from(&fr.gx[j]);
-            g.fixed_view_mut::<3, 3>(0, 6 * j + 3).copy_from(&fr.gr[j]);
-        }
+        // rows r0..r0+3 of column c of B
+        let col3 = |r0: usize, c: usize| Vector3::new(b[(r0, c)], b[(r0 + 1, c)], b[(r0 + 2, c)]);
+        // the columns of G = [gx₀ gr₀ gx₁ gr₁ …] (3 x size)
+        let g: [Vector3<f64>; 24] = std::array::from_fn(|c| {
+            let (j, k) = (c / 6, c % 6);
+            match (c < size, k < 3) {
+                (false, _) => Vector3::zeros(),
+                (true, true) => fr.gx[j].column(k).into_owned(),
+                (true, false) => fr.gr[j].column(k - 3).into_owned(),
+            }
+        });
         let mean = (0..n).map(|i| v3(fl, 6 * i)).sum::<Vector3<f64>>() / n as f64;
-        // m = Σ [bᵢ]×ᵀ f_uᵢ - tᵢ and its variation Δm = Σ [f_uᵢ]× Δbᵢ - Mθᵢ Δθᵢ
+        // m = Σ [bᵢ]×ᵀ f_uᵢ - tᵢ and its variation Δm = Σ [f_uᵢ]× Δbᵢ - Mθᵢ Δθᵢ (columns)
         let mut m = Vector3::zeros();
-        let mut dm = DMatrix::zeros(3, size);
+        let mut dm = [Vector3::zeros(); 24];
         let mut t = [Vector3::zeros(); 4];
         let mut mth = [Matrix3::zeros(); 4];
         for i in 0..n {
@@ -263,18 +269,25 @@ impl Reference {
             t[i] = tangent_inverse(&th).transpose() * ft;
             mth[i] = tangent_inverse_transpose_derivative(&th, &ft);
             m += spin(&bi).transpose() * fu - t[i];
-            dm += spin(&fu) * b.rows(6 * i, 3) - mth[i] * b.rows(6 * i + 3, 3);
+            let sf = spin(&fu);
+            for (c, dmc) in dm[..size].iter_mut().enumerate() {
+                *dmc += sf * col3(6 * i, c) - mth[i] * col3(6 * i + 3, c);
+            }
         }
         for j in 0..n {
             let fu = v3(fl, 6 * j);
-            let rows_x = -(e * spin(&(fu - mean))) * &g + fr.gx[j].transpose() * &dm;
-            let rows_w = -(e * spin(&t[j])) * &g
-                + (e * mth[j]) * b.rows(6 * j + 3, 3)
-                + fr.gr[j].transpose() * &dm;
-            let mut rx = kt.rows_mut(6 * j, 3);
-            rx += &rows_x;
-            let mut rw = kt.rows_mut(6 * j + 3, 3);
-            rw += &rows_w;
+            let ax = -(e * spin(&(fu - mean)));
+            let aw = -(e * spin(&t[j]));
+            let em = e * mth[j];
+            let (gxt, grt) = (fr.gx[j].transpose(), fr.gr[j].transpose());
+            for c in 0..size {
+                let rx = ax * g[c] + gxt * dm[c];
+                let rw = aw * g[c] + em * col3(6 * j + 3, c) + grt * dm[c];
+                for k in 0..3 {
+                    kt[(6 * j + k, c)] += rx[k];
+                    kt[(6 * j + 3 + k, c)] += rw[k];
+                }
+            }
         }
         // Δgxⱼᵀ m, Δgrⱼᵀ m: central differences of the frame
         let scale = (1..n).map(|i| (x[i] - x[0]).norm()).fold(0.0, f64::max);

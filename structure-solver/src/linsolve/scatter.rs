@@ -58,9 +58,10 @@ impl Fingerprint {
 pub struct ScatterMap {
     /// Slot of each triplet (`DROPPED`: not assembled).
     slot: Vec<usize>,
-    /// The triplets summed into slot `s`: `source[start[s]..start[s + 1]]`, increasing.
+    /// The triplets summed into slot `s`: `source[start[s]..start[s + 1]]`, increasing (32
+    /// bits: the scatter reads one per triplet).
     start: Vec<usize>,
-    source: Vec<usize>,
+    source: Vec<u32>,
     fingerprint: Fingerprint,
 }
 
@@ -77,6 +78,9 @@ impl ScatterMap {
     ) -> Result<Self, FactorError> {
         let n_slots = row_idx.len();
         let ncols = col_ptr.len() - 1;
+        if u32::try_from(count).is_err() {
+            return Err(FactorError(format!("{count} triplets: at most {} fit", u32::MAX)));
+        }
         let mut slot = vec![DROPPED; count];
         slot.par_iter_mut().enumerate().with_min_len(4096).try_for_each(|(k, s)| {
             let Some((i, j)) = index(k) else { return Ok(()) };
@@ -100,9 +104,9 @@ impl ScatterMap {
             start[s + 1] += start[s];
         }
         let mut fill = start[..n_slots].to_vec();
-        let mut source = vec![0usize; start[n_slots]];
+        let mut source = vec![0u32; start[n_slots]];
         for (k, &s) in slot.iter().enumerate().filter(|(_, &s)| s != DROPPED) {
-            source[fill[s]] = k;
+            source[fill[s]] = k as u32; // count fits (checked above)
             fill[s] += 1;
         }
         Ok(ScatterMap { slot, start, source, fingerprint })
@@ -158,7 +162,7 @@ impl ScatterMap {
         assert_eq!(out.len(), self.n_slots(), "values of the wrong pattern");
         let (start, source) = (&self.start, &self.source);
         out.par_iter_mut().enumerate().with_min_len(2048).for_each(|(s, o)| {
-            *o = source[start[s]..start[s + 1]].iter().fold(0.0, |acc, &k| acc + value(k));
+            *o = source[start[s]..start[s + 1]].iter().fold(0.0, |acc, &k| acc + value(k as usize));
         });
     }
 

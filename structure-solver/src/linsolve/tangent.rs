@@ -38,13 +38,15 @@ impl Tangent {
     pub fn clear(&mut self) {
         self.dofs.clear();
         self.dof_start.clear();
-        self.values.clear();
         self.value_start.clear();
+        self.values.clear();
         self.entries.clear();
     }
 
-    /// Replaces the blocks by one block per dof list of `lists` (values zero) and returns
-    /// their values, one mutable slice per block, to be filled in parallel.
+    /// Replaces the blocks by one block per dof list of `lists` and returns their values, one
+    /// mutable slice per block, to be filled in parallel: the caller writes every value (they
+    /// hold what the last call left, not zeros: a refill would write the whole array once more
+    /// each Newton iteration).
     pub fn set_blocks<L: IntoIterator<Item = usize>>(
         &mut self,
         lists: impl Iterator<Item = L>,
@@ -63,7 +65,6 @@ impl Tangent {
             total += n * n;
             self.value_start.push(total);
         }
-        self.values.clear();
         self.values.resize(total, 0.0);
         let mut out = Vec::with_capacity(self.dof_start.len() - 1);
         let mut rest = &mut self.values[..];
