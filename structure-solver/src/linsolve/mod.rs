@@ -194,7 +194,7 @@ impl FreeSolver {
         }
     }
 
-    /// Makes the pattern and scatter map fit the triplet stream `k`: the map is kept when the
+    /// Makes the pattern and scatter map fit the stream `k`: the map is kept when the
     /// stream passes its spot check (its full fingerprint after a topology change), the
     /// pattern when it holds every entry.
     fn fit(&mut self, k: &Tangent) -> Result<(), FactorError> {
@@ -230,7 +230,7 @@ impl FreeSolver {
     }
 
     /// `J = ck K_ff + cm diag(mass)_ff` (`mass: None` for a static tangent) from the full
-    /// triplets `k` (entries on constrained dofs dropped, duplicates summed in order).
+    /// stream `k` (entries on constrained dofs dropped, duplicates summed in order).
     fn jacobian(
         &mut self,
         k: &Tangent,
