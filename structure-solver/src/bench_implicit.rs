@@ -45,6 +45,9 @@ pub struct ImplicitRun {
     pub newton_iterations: usize,
     pub factorisations: usize,
     pub gmres_iterations: usize,
+    /// Newton iterations whose solve took the Jacobian's products from differences of the
+    /// residual instead of assembling it.
+    pub matrix_free_solves: usize,
     pub seconds_per_step: f64,
     pub seconds_per_newton_iteration: f64,
     /// Processor time of the process (all threads) per Newton iteration: on a machine shared
@@ -154,7 +157,7 @@ fn run_one(
         let t0 = Instant::now();
         im.step(&mut model, DT, None)?;
         let first = t0.elapsed().as_secs_f64();
-        let (mut its, mut fact, mut gmres) = (0, 0, 0);
+        let (mut its, mut fact, mut gmres, mut free) = (0, 0, 0, 0);
         let cpu0 = cpu_seconds();
         let t0 = Instant::now();
         for _ in 0..steps {
@@ -162,6 +165,7 @@ fn run_one(
             its += info.iterations;
             fact += info.factorisations;
             gmres += info.gmres_iterations;
+            free += info.matrix_free_solves;
         }
         let secs = t0.elapsed().as_secs_f64();
         let cpu = cpu_seconds() - cpu0;
@@ -177,6 +181,7 @@ fn run_one(
             newton_iterations: its,
             factorisations: fact,
             gmres_iterations: gmres,
+            matrix_free_solves: free,
             seconds_per_step: secs / steps as f64,
             seconds_per_newton_iteration: secs / its.max(1) as f64,
             cpu_seconds_per_newton_iteration: cpu / its.max(1) as f64,

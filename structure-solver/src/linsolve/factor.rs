@@ -12,7 +12,7 @@ use faer::sparse::SparseColMatRef;
 use faer::{Conj, Mat, MatMut, Par, Side};
 use rayon::prelude::*;
 
-use super::gmres::{self, Limits, Outcome};
+use super::gmres::{self, Limits, Operator, Outcome};
 use super::pattern::Pattern;
 use super::FactorError;
 
@@ -85,6 +85,11 @@ impl Jacobian {
         self.pattern.product(values, x, y);
     }
 
+    /// `J` (`transpose`: `Jᵀ`) as the operator of a GMRES solve.
+    pub fn operator(&self, transpose: bool) -> Product<'_> {
+        Product { j: self, transpose }
+    }
+
     /// `J` as a faer matrix.
     pub fn matrix(&self) -> SparseColMatRef<'_, usize, f64> {
         SparseColMatRef::new(self.pattern.symbolic_ref(), &self.a)
@@ -98,11 +103,33 @@ impl Drop for Jacobian {
     }
 }
 
+/// An assembled `J` or `Jᵀ` as a GMRES [`Operator`].
+pub(super) struct Product<'a> {
+    j: &'a Jacobian,
+    transpose: bool,
+}
+
+impl Operator for Product<'_> {
+    fn apply(&mut self, x: &[f64], y: &mut [f64]) {
+        self.j.product(x, y, self.transpose);
+    }
+
+    fn symmetric(&self) -> bool {
+        self.j.symmetric
+    }
+
+    fn norm1(&self) -> f64 {
+        self.j.norm1
+    }
+}
+
 /// The `LDLᵀ` values of `S = ½(J + Jᵀ)` for some `J` on `pattern`.
 #[derive(Debug)]
 pub(super) struct Ldlt {
     pattern: Arc<Pattern>,
     values: Vec<f64>,
+    /// `|J|₁` of the `J` factored.
+    pub norm1: f64,
 }
 
 impl Ldlt {
@@ -134,7 +161,7 @@ impl Ldlt {
                 .is_ok()
         } && values.iter().all(|v| v.is_finite());
         p.give(s);
-        let ldlt = Ldlt { pattern: Arc::clone(p), values };
+        let ldlt = Ldlt { pattern: Arc::clone(p), values, norm1: j.norm1 };
         ok.then_some(ldlt)
     }
 
@@ -243,9 +270,9 @@ impl Factor {
         let out = match &self.ldlt {
             Some(m) if !self.fresh => {
                 let one = Limits { restart: FRESH.restart, cycles: 1 };
-                return Ok(gmres::solve(&self.j, m, b, transpose, one, tol));
+                return Ok(gmres::solve(&mut self.j.operator(transpose), m, b, one, tol));
             }
-            Some(m) => gmres::solve(&self.j, m, b, transpose, FRESH, tol),
+            Some(m) => gmres::solve(&mut self.j.operator(transpose), m, b, FRESH, tol),
             None => Outcome { x: None, iterations: 0 },
         };
         if out.x.is_some() || !self.fresh {

@@ -75,6 +75,15 @@ impl FreeDofs {
         }
     }
 
+    /// The free entries of a full vector `v` into `out` (free numbering).
+    pub fn gather_values(&self, v: &[f64], out: &mut [f64]) {
+        for (d, i) in self.index.iter().enumerate() {
+            if let Some(i) = i {
+                out[*i] = v[d];
+            }
+        }
+    }
+
     /// Writes a free column into the free entries of a full vector (others untouched).
     pub fn scatter(&self, m: &Mat<f64>, out: &mut [f64]) {
         for (d, i) in self.index.iter().enumerate() {

@@ -1,8 +1,20 @@
 //! Restarted GMRES (Saad & Schultz 1986) for `J x = b` right-preconditioned with an `LDLᵀ`
 //! factorisation `S = L D Lᵀ`, symmetric, of `½(J + Jᵀ)` for this `J` or an earlier one:
-//! `J S⁻¹ y = b`, `x = S⁻¹ y`, Givens rotations on the Hessenberg matrix.
+//! `J S⁻¹ y = b`, `x = S⁻¹ y`, Givens rotations on the Hessenberg matrix. `J` is an
+//! [`Operator`]: an assembled matrix, or the directional derivative of a residual
+//! (matrix-free).
 
-use super::factor::{Jacobian, Ldlt};
+use super::factor::Ldlt;
+
+/// The `J` GMRES solves with.
+pub(super) trait Operator {
+    /// `y = J x`.
+    fn apply(&mut self, x: &[f64], y: &mut [f64]);
+    /// `J = Jᵀ` to round-off (or nearly: GMRES then starts from `S⁻¹ b`).
+    fn symmetric(&self) -> bool;
+    /// `|J|₁`, the scale of the backward error.
+    fn norm1(&self) -> f64;
+}
 /// Backward error `|b - J x| / (|J|₁ |x|)` accepted as converged (what a direct solve of an
 /// ill-conditioned matrix gives) when the relative residual cannot reach the tolerance.
 const BACKWARD_TOL: f64 = 1e-14;
@@ -25,17 +37,10 @@ fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Solves `J x = b` (`transpose`: `Jᵀ x = b`) to a relative residual of `tol` (or the
-/// backward error `BACKWARD_TOL`). A symmetric `J` starts from `x = S⁻¹ b` (exact when `S`
-/// is the factor of this `J`: one iteration); otherwise from 0.
-pub(super) fn solve(
-    j: &Jacobian,
-    m: &Ldlt,
-    b: &[f64],
-    transpose: bool,
-    lim: Limits,
-    tol: f64,
-) -> Outcome {
+/// Solves `J x = b` to a relative residual of `tol` (or the backward error `BACKWARD_TOL`).
+/// A symmetric `J` starts from `x = S⁻¹ b` (exact when `S` is the factor of this `J`: one
+/// iteration); otherwise from 0.
+pub(super) fn solve(j: &mut dyn Operator, m: &Ldlt, b: &[f64], lim: Limits, tol: f64) -> Outcome {
     let n = b.len();
     let bn = norm(b);
     let mut x = vec![0.0; n];
@@ -45,18 +50,19 @@ pub(super) fn solve(
     let mut iterations = 0;
     let mut r = b.to_vec();
     let mut w = vec![0.0; n];
-    if j.symmetric {
+    if j.symmetric() {
         x.copy_from_slice(b);
         m.solve_in_place(&mut x);
         iterations += 1;
-        j.product(&x, &mut w, transpose);
+        j.apply(&x, &mut w);
         for ((ri, bi), v) in r.iter_mut().zip(b).zip(&w) {
             *ri = bi - v;
         }
     }
+    let norm1 = j.norm1();
     let converged = |r: &[f64], x: &[f64]| {
         let rn = norm(r);
-        rn <= tol * bn || rn <= BACKWARD_TOL * j.norm1 * norm(x)
+        rn <= tol * bn || rn <= BACKWARD_TOL * norm1 * norm(x)
     };
     for _ in 0..lim.cycles {
         if converged(&r, &x) {
@@ -73,7 +79,7 @@ pub(super) fn solve(
             let mut zk = v[k].clone();
             m.solve_in_place(&mut zk);
             iterations += 1;
-            j.product(&zk, &mut w, transpose);
+            j.apply(&zk, &mut w);
             let mut hk = vec![0.0; k + 2];
             for (i, vi) in v.iter().enumerate() {
                 let d: f64 = w.iter().zip(vi).map(|(a, b)| a * b).sum();
@@ -117,7 +123,7 @@ pub(super) fn solve(
                 *xi += yk * zi;
             }
         }
-        j.product(&x, &mut w, transpose);
+        j.apply(&x, &mut w);
         for ((ri, bi), wi) in r.iter_mut().zip(b).zip(&w) {
             *ri = bi - wi;
         }

@@ -23,6 +23,9 @@
 //! (the next Newton iterations, the next time or load steps) while that converges within
 //! [`REUSE_ITERATIONS`]; a solve that needs more marks the factor stale (the next matrix is
 //! factored afresh), and one that does not converge within a GMRES cycle refactors at once.
+//! While the kept factor preconditions well, a caller that can form the Jacobian's products
+//! itself (`time::implicit`, from differences of its residual) solves without assembling
+//! ([`FreeSolver::solve_matrix_free`]), to no less than [`MATRIX_FREE_TOL`].
 
 mod factor;
 mod free_dofs;
@@ -71,6 +74,10 @@ pub fn forcing(residual: f64, previous: Option<f64>, target: f64) -> f64 {
     ew.min(FORCING_MAX).max(floor)
 }
 
+/// The tightest relative residual of [`FreeSolver::solve_matrix_free`]: its products carry
+/// the error of a difference quotient.
+pub const MATRIX_FREE_TOL: f64 = 1e-5;
+
 /// GMRES iterations (preconditioner applications) a kept factor may take on one right-hand
 /// side before the next solve refactors.
 pub const REUSE_ITERATIONS: usize = 8;
@@ -89,6 +96,8 @@ pub struct SolveStats {
     pub gmres_iterations: usize,
     /// Right-hand sides solved.
     pub solves: usize,
+    /// Of those, solved without an assembled matrix ([`FreeSolver::solve_matrix_free`]).
+    pub matrix_free_solves: usize,
 }
 
 impl SolveStats {
@@ -98,6 +107,7 @@ impl SolveStats {
             factorisations: self.factorisations - earlier.factorisations,
             gmres_iterations: self.gmres_iterations - earlier.gmres_iterations,
             solves: self.solves - earlier.solves,
+            matrix_free_solves: self.matrix_free_solves - earlier.matrix_free_solves,
         }
     }
 }
@@ -332,6 +342,54 @@ impl FreeSolver {
         Ok(())
     }
 
+    /// Solves `J x = b` in place (`rhs`: `b` in free numbering) for a `J` known only through
+    /// its products with full dof vectors, `product(d, out)`: `out = J d` (`d` zero on the
+    /// constrained dofs; its constrained entries are ignored), by one GMRES cycle
+    /// preconditioned with the kept factor, to the relative residual `tol` (at least
+    /// `SOLVE_TOL`). `Ok(false)` leaves `rhs` alone when there is no kept factor to use (none
+    /// yet, not reusing, stale, or the topology changed since the last assembly) or the cycle
+    /// did not converge (the factor is then stale): [`Self::assemble`] and
+    /// [`Self::solve_in_place_to`] refactor.
+    pub fn solve_matrix_free(
+        &mut self,
+        product: &mut dyn FnMut(&[f64], &mut [f64]),
+        rhs: &mut [f64],
+        tol: f64,
+    ) -> Result<bool, FactorError> {
+        let (Some(pattern), Some(kept)) = (&self.pattern, &self.kept) else {
+            return Ok(false);
+        };
+        if !self.reuse || self.stale || self.recheck || !kept.is_on(pattern) {
+            return Ok(false);
+        }
+        if rhs.len() != pattern.n {
+            return Err(FactorError(format!(
+                "right-hand side of {} rows for {} free dofs",
+                rhs.len(),
+                pattern.n
+            )));
+        }
+        let n = self.free.n_dof();
+        let mut op = FullProduct {
+            free: &self.free,
+            product,
+            d: vec![0.0; n],
+            jd: vec![0.0; n],
+            norm1: kept.norm1,
+        };
+        let one = gmres::Limits { restart: factor::FRESH.restart, cycles: 1 };
+        let out = gmres::solve(&mut op, kept, rhs, one, tol.max(MATRIX_FREE_TOL));
+        self.stats.gmres_iterations += out.iterations;
+        self.stale = out.iterations > REUSE_ITERATIONS || out.x.is_none();
+        let Some(x) = out.x else {
+            return Ok(false);
+        };
+        self.stats.solves += 1;
+        self.stats.matrix_free_solves += 1;
+        rhs.copy_from_slice(&x);
+        Ok(true)
+    }
+
     /// Assembles and factors `J` (as [`Self::assemble`]) and returns the factorisation, which
     /// solves through faer's `Solve`; the kept factor is left alone.
     pub fn factor(
@@ -344,6 +402,33 @@ impl FreeSolver {
         f.refactor()?;
         self.stats.factorisations += 1;
         Ok(f)
+    }
+}
+
+/// A free-dof operator from a product on full dof vectors.
+struct FullProduct<'a> {
+    free: &'a FreeDofs,
+    product: &'a mut dyn FnMut(&[f64], &mut [f64]),
+    d: Vec<f64>,
+    jd: Vec<f64>,
+    norm1: f64,
+}
+
+impl gmres::Operator for FullProduct<'_> {
+    fn apply(&mut self, x: &[f64], y: &mut [f64]) {
+        self.d.fill(0.0);
+        self.free.scatter_values(x, &mut self.d);
+        (self.product)(&self.d, &mut self.jd);
+        self.free.gather_values(&self.jd, y);
+    }
+
+    /// Nearly: the kept factor's `S` approximates `J`, so GMRES starts from `S⁻¹ b`.
+    fn symmetric(&self) -> bool {
+        true
+    }
+
+    fn norm1(&self) -> f64 {
+        self.norm1
     }
 }
 
