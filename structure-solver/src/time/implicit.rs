@@ -3,7 +3,7 @@
 //! converges within `REUSE_ITERATIONS`, refactored otherwise; each solve only as accurate as
 //! Newton's convergence needs, `linsolve::forcing`; a solve that need not go below
 //! `MATRIX_FREE_TOL` takes the Jacobian's products from differences of the residual instead
-//! of assembling it, [`Difference`]):
+//! of assembling it, `Difference`):
 //!
 //! - **Newmark, average acceleration** (β = 1/4, γ = 1/2; Newmark 1959): unknown `Δu`,
 //!   `a^{n+1} = 4/Δt² (Δu - Δt v^n) - a^n`, `v^{n+1} = v^n + Δt/2 (a^n + a^{n+1})`, residual
@@ -45,7 +45,7 @@ pub struct NewtonParams {
     pub max_iter: usize,
     /// Each linear solve goes only as far as Newton's convergence needs (`linsolve::forcing`),
     /// and while the kept factor preconditions well the Jacobian is not assembled: GMRES takes
-    /// its products from a difference of residuals ([`Difference`]). `false`: every solve to
+    /// its products from a difference of residuals (`Difference`). `false`: every solve to
     /// `SOLVE_TOL` on the assembled Jacobian, so that runs whose matrices differ in round-off
     /// (another dof numbering, added dofs) follow the same Newton iterates to round-off.
     pub inexact: bool,
@@ -69,7 +69,7 @@ pub struct StepInfo {
     pub factorisations: usize,
     /// GMRES iterations (preconditioner applications) of this step's solves.
     pub gmres_iterations: usize,
-    /// Solves of this step without an assembled Jacobian ([`Difference`]).
+    /// Solves of this step without an assembled Jacobian (`Difference`).
     pub matrix_free_solves: usize,
 }
 
