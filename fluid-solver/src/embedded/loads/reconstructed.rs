@@ -63,17 +63,36 @@ pub(super) fn vertex_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3],
 
 /// The cut cells with their cut edges: a pair `(cell, cut)` for every cell holding both ends of
 /// cut edge `cut`, ascending. Every cell with a cut edge appears, so every cell that can hold a
-/// polygon.
+/// polygon. The cells of an edge are the common entries of its ends' node-to-cell rows (both
+/// ascending: a merge, which reads no cell), found in parallel and sorted in parallel (the pairs
+/// are distinct, so the order is the same for any number of threads).
 pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
-    let mut pairs = Vec::with_capacity(8 * view.cuts.len());
-    for (k, c) in view.cuts.iter().enumerate() {
-        let [i, j] = view.mesh.edges[c.edge as usize];
-        let around = view.adjacency.cells_of(i as usize);
-        let holding =
-            around.iter().filter(|&&cell| view.mesh.cells[cell as usize].nodes().contains(&j));
-        pairs.extend(holding.map(|&cell| (cell, k as u32)));
-    }
-    pairs.sort_unstable();
+    let adjacency = view.adjacency;
+    let mut pairs: Vec<(u32, u32)> = view
+        .cuts
+        .par_iter()
+        .enumerate()
+        .with_min_len(1024)
+        .fold(Vec::new, |mut pairs, (k, c)| {
+            let [i, j] = view.mesh.edges[c.edge as usize];
+            let (a, b) = (adjacency.cells_of(i as usize), adjacency.cells_of(j as usize));
+            let (mut x, mut y) = (0, 0);
+            while x < a.len() && y < b.len() {
+                match a[x].cmp(&b[y]) {
+                    std::cmp::Ordering::Less => x += 1,
+                    std::cmp::Ordering::Greater => y += 1,
+                    std::cmp::Ordering::Equal => {
+                        pairs.push((a[x], k as u32));
+                        x += 1;
+                        y += 1;
+                    }
+                }
+            }
+            pairs
+        })
+        .flatten_iter()
+        .collect();
+    pairs.par_sort_unstable();
     pairs
 }
 
