@@ -127,6 +127,8 @@ struct Difference {
     g: Vec<f64>,
     md: Vec<f64>,
     translations: Vec<[f64; 3]>,
+    /// A product has moved the model since the flag was cleared.
+    moved: bool,
 }
 
 impl Difference {
@@ -170,6 +172,7 @@ impl Difference {
             *s = h * stage * di;
         }
         model.apply_increment(&self.shift);
+        self.moved = true;
         out_of_balance(model, t, extra, &mut self.fi, &mut self.g);
         for s in &mut self.shift {
             *s = -*s;
@@ -371,13 +374,14 @@ impl Implicit {
                     diff.base[i] = self.r[i] + self.inertia[i];
                 }
                 let u_max = diff.scale(model);
+                diff.moved = false;
                 let mut product = |d: &[f64], out: &mut [f64]| {
                     diff.product(&mut *model, (t_load, extra), (cm, stage, u_max), d, out)
                 };
                 let rhs = sol.col_as_slice_mut(0);
                 match self.solver.solve_matrix_free(&mut product, rhs, eta) {
                     Ok(done) => {
-                        if !done {
+                        if !done && self.difference.moved {
                             // the trial material state back at the iterate for its tangent
                             self.difference.fi.fill(0.0);
                             model.internal_force(&mut self.difference.fi);
