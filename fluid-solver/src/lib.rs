@@ -35,5 +35,6 @@ pub mod setup;
 pub mod solver;
 pub mod special_edges;
 pub mod state;
+pub mod symmetry;
 pub mod time;
 pub mod two_phase;

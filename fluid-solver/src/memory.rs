@@ -75,6 +75,7 @@ mod tests {
         let ws = Workspace::new(nodes);
         let held = semi.mesh.memory_bytes()
             + semi.gradient.memory_bytes()
+            + semi.symmetry.memory_bytes()
             + ws.memory_bytes()
             + crate::state::State::new(vec![[0.0; 5]; nodes]).memory_bytes();
         let estimate = estimate(nodes as f64, cells as f64);

@@ -48,6 +48,7 @@ use crate::reconstruct::limiter::Limiter;
 use crate::reconstruct::muscl;
 use crate::special_edges::{SpecialEdges, SpecialKind};
 use crate::state::{MaterialId, Workspace};
+use crate::symmetry::SymmetryPlanes;
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -87,6 +88,9 @@ pub struct Semidiscretization {
     pub gradient: LsqGradient,
     /// `(index in mesh.boundaries, condition)`, applied in this order.
     pub patches: Vec<(usize, BoundaryCondition)>,
+    /// The normals of the symmetry planes, along which no node on them has a momentum residual
+    /// ([`crate::symmetry`]).
+    pub symmetry: SymmetryPlanes,
 }
 
 impl Semidiscretization {
@@ -141,6 +145,12 @@ impl Semidiscretization {
             return Err(MeshError::Input("the EOS table is empty: give at least one fluid".into()));
         }
         let gradient = LsqGradient::with_planes(&mesh, None, planes);
+        let symmetric: Vec<usize> = patches
+            .iter()
+            .filter(|p| matches!(p.1, BoundaryCondition::Symmetry))
+            .map(|p| p.0)
+            .collect();
+        let symmetry = SymmetryPlanes::new(&mesh, &symmetric);
         let mut semi = Semidiscretization {
             mesh,
             eos,
@@ -150,6 +160,7 @@ impl Semidiscretization {
             numerics,
             gradient,
             patches,
+            symmetry,
         };
         semi.set_materials(material)?;
         Ok(semi)
@@ -310,6 +321,7 @@ impl Semidiscretization {
             }
             self.block_fluxes(b, prim, grad, r, wall.as_ref())?;
             self.boundary_fluxes(blocks.nodes(b), prim, r)?;
+            self.symmetry.project(blocks.completed(b), r);
             for i in blocks.completed(b) {
                 update(i, &r[i], &mut o[i]);
             }

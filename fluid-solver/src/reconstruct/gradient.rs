@@ -149,6 +149,16 @@ impl MirrorPlanes {
         self.nodes.is_empty()
     }
 
+    /// Every node on a plane with its planes' unit normals, in patch order; nodes ascending.
+    pub fn by_node(&self) -> impl Iterator<Item = (usize, &[[f64; 3]])> {
+        let mut start = 0;
+        self.nodes.chunk_by(|a, b| a == b).map(move |run| {
+            let range = start..start + run.len();
+            start = range.end;
+            (run[0] as usize, &self.normals[range])
+        })
+    }
+
     /// The planes of node `i`, in patch order.
     fn of_node(&self, i: usize) -> &[[f64; 3]] {
         &self.normals[self.entries(&(i..i + 1))]
