@@ -5,7 +5,9 @@
 //! The problem is solved along the interface normal at the node, `n̂ = ±∇φ_i/|∇φ_i|` pointing from
 //! fluid `a` into fluid `b` (the level set's normal: on a 1D tube of tets exactly the axis, where
 //! the normals of single edges are not), between `W_i` (EOS_a) and `W̄_b`, the mean primitive
-//! state of the neighbours that held `b` at `t^n` (EOS_b), with the cavitation cut-off of the pair
+//! state of the neighbours that held `b` at `t^n` (EOS_b; at a node on symmetry planes each
+//! neighbour counted with its mirror images, [`crate::symmetry::SymmetryPlanes::images`], so that
+//! the mean is that of the whole mirrored stencil), with the cavitation cut-off of the pair
 //! ([`crate::two_phase::cutoff`]). Its star state on `b`'s side of the contact, `(ρ*_b, u*, p*)`,
 //! gives the ghost state `W = (ρ*_b, v_i + (u* - v_i·n̂) n̂, p*)` (the node keeps its tangential
 //! velocity, as in the ghost-fluid flux), and the node's conserved variables are recomputed with
@@ -39,21 +41,24 @@ pub fn update_materials(
         let (a, b) = (old[i], ls.material_of(state.phi[i]));
         let (eos_a, eos_b) = (&semi.eos[a as usize], &semi.eos[b as usize]);
         let wi = eos_a.cons_to_prim(&state.cons[i]);
-        // The neighbours of fluid b: their mean state, and the mean direction towards them.
+        // The neighbours of fluid b: their mean state, and the mean direction towards them; on
+        // symmetry planes each neighbour counts with its mirror images.
         let mut wb = [0.0; 5];
         let mut towards = [0.0; 3];
-        let mut count = 0usize;
+        let mut count = 0.0;
         for (j, e) in ls.adjacency.neighbours(mesh, i) {
             if old[j] == b && through.is_none_or(|t| t[e as usize]) {
                 let wj = eos_b.cons_to_prim(&state.cons[j]);
+                let d = sub(mesh.coords[j], mesh.coords[i]);
+                let images = semi.symmetry.images(i, d);
                 for k in 0..5 {
-                    wb[k] += wj[k];
+                    wb[k] += images * wj[k];
                 }
-                towards = add(towards, sub(mesh.coords[j], mesh.coords[i]));
-                count += 1;
+                towards = add(towards, scale(d, images));
+                count += images;
             }
         }
-        if count == 0 {
+        if count == 0.0 {
             return Err(FluidError::LevelSet(format!(
                 "node {i} (x = {:?}) changed from material {a} to {b}, but none of its \
                  neighbours held material {b}: the interface moved more than one edge in a step \
@@ -61,7 +66,7 @@ pub fn update_materials(
                 mesh.coords[i]
             )));
         }
-        let wb = wb.map(|s| s / count as f64);
+        let wb = wb.map(|s| s / count);
         // ∇φ points to φ >= 0, the side of materials[1].
         let g = grad_phi[i][0];
         let to_b = if b == ls.materials[1] { 1.0 } else { -1.0 };

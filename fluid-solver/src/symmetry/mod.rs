@@ -81,6 +81,15 @@ impl SymmetryPlanes {
         &self.directions[self.entries(&(i..i + 1))]
     }
 
+    /// The number of images of a neighbour at `d = x_j - x_i` of node `i` on the mirrored mesh:
+    /// 2 for each constrained direction of `i` that `d` has a component along (beyond `1e-6 |d|`),
+    /// so that a mean over the half stencil weighted by it is the mean over the whole mirrored
+    /// stencil, as the mirror images of `j` contribute (with perpendicular planes, exactly).
+    pub fn images(&self, i: usize, d: [f64; 3]) -> f64 {
+        let tol = INDEPENDENCE * norm(d);
+        self.of_node(i).iter().filter(|&&n| dot(d, n).abs() > tol).fold(1.0, |w, _| 2.0 * w)
+    }
+
     /// Removes the momentum components `r[i][1..4]` along the constrained directions of every
     /// node `i` in `nodes`.
     #[inline]
