@@ -4,7 +4,9 @@
 //! `F_b(W_i, n_i)` built from the node state (first order at the boundary, as in vertex-centred
 //! codes):
 //! - slip wall and symmetry: the wall flux of thesis Alg. 5.1 with a fixed wall
-//!   ([`crate::flux::wall_flux`]): the one-sided Riemann problem gives the wall pressure `p*`;
+//!   ([`crate::flux::wall_flux`]): the one-sided Riemann problem gives the wall pressure `p*`
+//!   (at symmetry planes the operator then also removes the momentum residual along the normal,
+//!   [`crate::symmetry`]);
 //! - far field: the upwind flux `F(W_i, W_∞, n)` against the free stream: flux-difference
 //!   splitting takes the incoming characteristics from `W_∞` and the outgoing ones from `W_i`
 //!   (non-reflecting for waves leaving along `n`, the characteristic far field of Steger-Warming

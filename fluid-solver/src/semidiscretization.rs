@@ -6,7 +6,9 @@
 //! the nodal least-squares gradients of the primitive variables, limited ([`crate::reconstruct`];
 //! mirror-symmetric at the nodes on symmetry planes and plane slip walls,
 //! [`crate::reconstruct::gradient`]), then the numerical flux, added at once to `R_i` (`+F`) and
-//! `R_j` (`-F`); per block, the boundary fluxes of its nodes, patch by patch in a fixed order.
+//! `R_j` (`-F`); per block, the boundary fluxes of its nodes, patch by patch in a fixed order, and
+//! at the nodes on symmetry planes the momentum residual along their normals removed
+//! ([`crate::symmetry`]).
 //! Every node hears from its edges in an order fixed by the mesh, so the result is bitwise the same
 //! for any number of threads, and no per-edge flux buffer or gather pass is needed. A node's
 //! residual is complete inside the same pass, so the time integrator applies its update there
