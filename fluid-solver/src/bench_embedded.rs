@@ -7,7 +7,8 @@
 //!   structure; the report gives the cells it crosses per step):
 //!   whole steps of [`EmbeddedRun::step`] (CFL step, tracking, filling the uncovered nodes, the
 //!   step's view with its masked gradient, the two RK2 stages with the wall fluxes, `p*` and the
-//!   loads), their node-steps/s/core and its ratio to the single-material row, the tracking
+//!   loads), their node-steps/s/core and its ratio to that of the single-material step, timed
+//!   once after each of them (interleaved: a shared machine's load falls on both), the tracking
 //!   share of the step, and the split of the tracking into its parts (timed one by one on a
 //!   second tracker given the same motion, and checked against the run's), with the passes over
 //!   the whole mesh they replace (the intersection of every edge, a new step view);
@@ -42,6 +43,7 @@ use crate::riemann::PressureCutoff;
 use crate::semidiscretization::Semidiscretization;
 use crate::state::{State, Workspace};
 use crate::time::cfl::stable_time_step;
+use crate::time::{rk2_step, TimeStepping};
 use interface_protocol::case::{InterfaceTreatment, LoadAlgorithm, Motion, Tracking};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -59,8 +61,12 @@ pub struct TrackingMeasurement {
     /// One whole step with the surface ([`EmbeddedRun::step`]).
     pub step_seconds: f64,
     pub node_steps_per_second_per_core: f64,
-    /// This row's node-steps/s/core over the single-material row's at this thread count.
+    /// This row's node-steps/s/core over the single-material step's at this thread count:
+    /// `single_material_step_seconds / step_seconds`.
     pub ratio_to_single_material: f64,
+    /// The single-material RK2 step of the bench row on the same box, one after each step of
+    /// this row in the same pool (interleaved, so a change of load on a shared machine falls on
+    /// both alike), mean over the same steps.
     pub single_material_step_seconds: f64,
     /// The step's tracking: advance, fill, step view (`EmbeddedRun::tracking_s`).
     pub tracking_seconds: f64,
@@ -200,10 +206,7 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
         let mut measurements = Vec::new();
         for m in &fluid.measurements {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(m.threads).build()?;
-            let (c, mut t) = pool.install(|| track(&semi, &initial, spec, steps, speed, &dir))?;
-            t.single_material_step_seconds = m.seconds_per_step;
-            t.ratio_to_single_material =
-                t.node_steps_per_second_per_core / m.node_steps_per_second_per_core;
+            let (c, t) = pool.install(|| track(&semi, &initial, spec, steps, speed, &dir))?;
             measurements.push(t);
             case = Some(c);
         }
@@ -223,6 +226,7 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
     let surface_bytes = std::mem::size_of_val(&s.triangles[..])
         + std::mem::size_of_val(&s.element_of[..])
         + std::mem::size_of_val(&s.phi[..])
+        + std::mem::size_of_val(&s.open_part[..])
         + 4 * std::mem::size_of_val(&s.x_a[..]);
     split.insert("tracker".to_string(), tracker.memory_bytes());
     split.insert("surface".to_string(), surface_bytes);
@@ -278,6 +282,9 @@ fn track(
     let mut run_semi = semi.clone();
     let mut state = initial.clone();
     let mut ws = Workspace::new(mesh.n_nodes());
+    // The single-material steps interleaved with the run's.
+    let (mut single_state, mut single_ws) = (initial.clone(), Workspace::new(mesh.n_nodes()));
+    let single_stepping = TimeStepping::Global { cfl: CFL };
     let mut t = 0.0;
     let mut per_step: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
     let mut split: BTreeMap<String, Vec<f64>> = BTreeMap::new();
@@ -290,7 +297,11 @@ fn track(
         let dt = run.step(&mut run_semi, &mut state, &mut ws, CFL, t, f64::INFINITY, None)?;
         let step_seconds = start.elapsed().as_secs_f64();
         t += dt;
+        let start = Instant::now();
+        rk2_step(semi, &mut single_state, &mut single_ws, single_stepping, 1.0)?;
+        let single_seconds = start.elapsed().as_secs_f64();
         if timed {
+            per_step.entry("single").or_default().push(single_seconds);
             per_step.entry("step").or_default().push(step_seconds);
             per_step.entry("tracking").or_default().push(run.tracking_s - tracking0);
             per_step.entry("loads").or_default().push(run.loads_s - loads0);
@@ -386,13 +397,14 @@ fn track(
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
     let (step, tracking, loads) = (mean_of("step"), mean_of("tracking"), mean_of("loads"));
+    let single = mean_of("single");
     let threads = rayon::current_num_threads();
     let m = TrackingMeasurement {
         threads,
         step_seconds: step,
         node_steps_per_second_per_core: mesh.n_nodes() as f64 / step / threads as f64,
-        ratio_to_single_material: f64::NAN,
-        single_material_step_seconds: f64::NAN,
+        ratio_to_single_material: single / step,
+        single_material_step_seconds: single,
         tracking_seconds: tracking,
         tracking_share: tracking / step,
         loads_seconds: loads,

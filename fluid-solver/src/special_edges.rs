@@ -23,11 +23,14 @@ use std::ops::Range;
 pub enum SpecialKind {
     /// Its end nodes hold different fluids: the two-phase ghost-fluid flux (thesis Eq. 3.9).
     TwoMaterial = 0,
+    /// Not cut by the embedded surface, and neither end is an active fluid node (inside a closed
+    /// body, or occluded): no flux at all, whatever fluids its ends held.
+    Dead = 1,
     /// Not cut by the embedded surface, but one end is not an active fluid node: the active end
     /// sees a slip wall on the edge's facet (a fallback the tracking should leave no room for).
-    Frozen = 1,
+    Frozen = 2,
     /// Cut by the embedded surface: Alg. 5.1 for each active end, whatever the fluids.
-    Cut = 2,
+    Cut = 3,
 }
 
 /// One special edge: its index in `mesh.edges` and its kind.

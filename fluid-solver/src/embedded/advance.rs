@@ -85,7 +85,8 @@ pub struct EmbeddedRun {
     /// Seconds spent tracking (refit, intersect, sides, fill) and in the loads.
     pub tracking_s: f64,
     pub loads_s: f64,
-    /// Seconds in the cut- and frozen-edge fluxes, summed over threads ([`super::step::FluxClock`]).
+    /// Seconds in the special edges' fluxes (cut and frozen; two-material ones with a level set),
+    /// summed over threads ([`super::step::FluxClock`]).
     pub wall_flux_s: f64,
     /// The fluid mass over the steps taken ([`MassBalance`]).
     pub mass: MassBalance,

@@ -1,10 +1,12 @@
 //! What the residual needs from the embedded boundary in one fluid step (DESIGN §5.1): the
-//! special edges of every block (the two-material edges of the scheme merged with the cut edges
-//! and the uncut edges that touch a node that is not active), the gradient operator with those
-//! edges masked out (flow gradients never cross the surface or a material interface), and the
-//! wall fluxes of Alg. 5.1 ([`super::riemann_fs`]). Built from the tracker at the first step and
-//! updated at each later one only where the tracking changed something (the gradient rebuilt at
-//! the ends of the edges whose status changed), read by the residual at each stage time.
+//! special edges of every block (the two-material edges of the scheme merged with the cut edges,
+//! the uncut edges that touch a node that is not active, and the dead edges between two such
+//! nodes, which carry no flux: a closed body's inside costs no edge work), the gradient operator
+//! with those edges masked out (flow gradients never cross the surface or a material interface),
+//! and the wall fluxes of Alg. 5.1 ([`super::riemann_fs`]). Built from the tracker at the first
+//! step and updated at each later one only where the tracking changed something (the gradient
+//! rebuilt at the ends of the edges whose status changed), read by the residual at each stage
+//! time.
 
 use super::riemann_fs::{one_sided, End, WallFluxError, WallFluxView, WallMaterial, WallPressures};
 use super::tracker::Tracker;
@@ -22,7 +24,7 @@ use std::time::Duration;
 /// The embedded boundary as one step's residuals read it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EmbeddedStep {
-    /// Two-material, frozen and cut edges, per block.
+    /// Two-material, dead, frozen and cut edges, per block.
     pub special: SpecialEdges,
     /// Least-squares gradients through the ordinary edges only.
     pub gradient: LsqGradient,
@@ -31,14 +33,16 @@ pub struct EmbeddedStep {
     /// Number of uncut edges with exactly one active end (taken as slip walls).
     pub frozen_edges: usize,
     /// What the step was built from, for [`EmbeddedStep::update`]: the active nodes, the cut
-    /// edges and the frozen edges (both ascending).
+    /// edges, the frozen edges and the dead edges (each ascending).
     active: Vec<bool>,
     cut: Vec<u32>,
     frozen: Vec<u32>,
+    dead: Vec<u32>,
     /// The states of the cut-edge fluxes ([`super::riemann_fs::interface`]); the second-order
     /// form needs the scheme's gradients (a first-order scheme takes the first-order form).
     pub interface: InterfaceTreatment,
-    /// Time spent in the fluxes of the cut and frozen edges since it was last taken.
+    /// Time spent in the special edges' fluxes (cut and frozen; two-material ones with a level
+    /// set) since it was last taken.
     pub wall_flux_clock: FluxClock,
 }
 
@@ -91,13 +95,16 @@ impl EmbeddedStep {
         let active = tracker.active.clone();
         let material = semi.material();
         let cut_mask = tracker.cuts.cut_mask(mesh.n_edges());
-        let mut frozen = Vec::new();
+        let (mut frozen, mut dead) = (Vec::new(), Vec::new());
         let mut used = vec![true; mesh.n_edges()];
         for (e, u) in used.iter_mut().enumerate() {
             let kind = EdgeKind::of(mesh.edges[e], cut_mask[e], &active, material);
             *u = kind.used;
             if kind.frozen {
                 frozen.push(e as u32);
+            }
+            if kind.dead {
+                dead.push(e as u32);
             }
         }
         let gradient = LsqGradient::with_planes(mesh, Some(&used), semi.gradient.planes().clone());
@@ -116,7 +123,7 @@ impl EmbeddedStep {
             true => interface,
             false => InterfaceTreatment::FirstOrder,
         };
-        let special = special_edges(semi, &frozen, &cut);
+        let special = special_edges(semi, &frozen, &dead, &cut);
         EmbeddedStep {
             special,
             gradient,
@@ -125,6 +132,7 @@ impl EmbeddedStep {
             active,
             cut,
             frozen,
+            dead,
             interface,
             wall_flux_clock: FluxClock::default(),
         }
@@ -147,7 +155,7 @@ impl EmbeddedStep {
         edges.sort_unstable();
         edges.dedup();
         let mut flipped = Vec::new();
-        let mut frozen_now = Vec::new();
+        let (mut frozen_now, mut dead_now) = (Vec::new(), Vec::new());
         for &e in &edges {
             let kind =
                 EdgeKind::of(mesh.edges[e as usize], is_cut(&cut, e), &tracker.active, material);
@@ -157,16 +165,25 @@ impl EmbeddedStep {
             if kind.frozen {
                 frozen_now.push(e);
             }
+            if kind.dead {
+                dead_now.push(e);
+            }
         }
         self.gradient.remask(mesh, &flipped, |i| tracker.adjacency.edges_of(i));
-        // The frozen edges that were not looked at stay frozen.
-        let mut frozen: Vec<u32> =
-            self.frozen.iter().copied().filter(|e| edges.binary_search(e).is_err()).collect();
-        frozen.extend(frozen_now);
-        frozen.sort_unstable();
-        self.special = special_edges(semi, &frozen, &cut);
+        // The frozen and dead edges that were not looked at stay as they were.
+        let kept = |list: &[u32], now: Vec<u32>| {
+            let mut kept: Vec<u32> =
+                list.iter().copied().filter(|e| edges.binary_search(e).is_err()).collect();
+            kept.extend(now);
+            kept.sort_unstable();
+            kept
+        };
+        let frozen = kept(&self.frozen, frozen_now);
+        let dead = kept(&self.dead, dead_now);
+        self.special = special_edges(semi, &frozen, &dead, &cut);
         self.frozen_edges = frozen.len();
         self.frozen = frozen;
+        self.dead = dead;
         self.cut = cut;
         self.active.copy_from_slice(&tracker.active);
     }
@@ -179,6 +196,7 @@ impl EmbeddedStep {
             + size_of_val(&self.active[..])
             + size_of_val(&self.cut[..])
             + size_of_val(&self.frozen[..])
+            + size_of_val(&self.dead[..])
     }
 }
 
@@ -188,6 +206,8 @@ struct EdgeKind {
     used: bool,
     /// Uncut with exactly one active end.
     frozen: bool,
+    /// Uncut with no active end.
+    dead: bool,
 }
 
 impl EdgeKind {
@@ -195,18 +215,28 @@ impl EdgeKind {
     fn of([i, j]: [u32; 2], cut: bool, active: &[bool], material: &[u8]) -> EdgeKind {
         let (i, j) = (i as usize, j as usize);
         let (ai, aj) = (active[i], active[j]);
-        EdgeKind { used: !cut && ai && aj && material[i] == material[j], frozen: !cut && ai != aj }
+        EdgeKind {
+            used: !cut && ai && aj && material[i] == material[j],
+            frozen: !cut && ai != aj,
+            dead: !cut && !ai && !aj,
+        }
     }
 }
 
-/// The scheme's special edges merged with the frozen and the cut edges.
-fn special_edges(semi: &Semidiscretization, frozen: &[u32], cut: &[u32]) -> SpecialEdges {
+/// The scheme's special edges merged with the dead, the frozen and the cut edges.
+fn special_edges(
+    semi: &Semidiscretization,
+    frozen: &[u32],
+    dead: &[u32],
+    cut: &[u32],
+) -> SpecialEdges {
     let blocks = &semi.mesh.blocks;
     let list = |edges: &[u32], kind| {
         let list = edges.iter().map(|&edge| SpecialEdge { edge, kind }).collect();
         SpecialEdges::from_sorted(blocks, list)
     };
     semi.special_edges()
+        .merge(&list(dead, SpecialKind::Dead), blocks)
         .merge(&list(frozen, SpecialKind::Frozen), blocks)
         .merge(&list(cut, SpecialKind::Cut), blocks)
 }
@@ -297,7 +327,9 @@ impl Wall<'_> {
                     r[node][k] += f.flux[k];
                 }
             }
-            SpecialKind::TwoMaterial => unreachable!("two-material edges are the scheme's"),
+            SpecialKind::TwoMaterial | SpecialKind::Dead => {
+                unreachable!("two-material and dead edges are the residual's")
+            }
         }
         Ok(())
     }
@@ -362,6 +394,31 @@ mod tests {
             format!("{:?}", a.gradient) == format!("{:?}", b.gradient),
             "{label}: gradient bits"
         );
+    }
+
+    /// Every edge is special exactly as its ends and cut say, brute force: cut edges `Cut`;
+    /// uncut ones with one active end `Frozen`, with none `Dead`; the others ordinary (one fluid).
+    fn assert_kinds(
+        semi: &Semidiscretization,
+        tracker: &Tracker,
+        step: &EmbeddedStep,
+        label: &str,
+    ) {
+        let mesh = &semi.mesh;
+        let cut = tracker.cuts.cut_mask(mesh.n_edges());
+        let expected: Vec<SpecialEdge> = (0..mesh.n_edges())
+            .filter_map(|e| {
+                let [i, j] = mesh.edges[e].map(|v| tracker.active[v as usize]);
+                let kind = match (cut[e], i, j) {
+                    (true, _, _) => SpecialKind::Cut,
+                    (false, false, false) => SpecialKind::Dead,
+                    (false, a, b) if a != b => SpecialKind::Frozen,
+                    _ => return None,
+                };
+                Some(SpecialEdge { edge: e as u32, kind })
+            })
+            .collect();
+        assert_eq!(step.special.all(), &expected[..], "{label}");
     }
 
     /// A sphere (Alg. 4.1 and 4.2) and a plane through the slip walls (Alg. 4.2, so the mirror
@@ -429,6 +486,7 @@ mod tests {
                     EmbeddedStep::new(&semi, &tracker, Some(10.0), InterfaceTreatment::SecondOrder);
                 assert_bitwise(&step, &fresh, &format!("{label}, step {k}"));
                 assert!(step.special.all().iter().any(|s| s.kind == SpecialKind::Cut));
+                assert_kinds(&semi, &tracker, &step, &format!("{label}, step {k}"));
                 let (mut g1, mut g2) =
                     (vec![[[0.0; 3]; 5]; mesh.n_nodes()], vec![[[0.0; 3]; 5]; mesh.n_nodes()]);
                 step.gradient.compute(mesh, &field, &mut g1);

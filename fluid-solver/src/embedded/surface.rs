@@ -21,6 +21,10 @@ pub struct Surface {
     pub phi: Vec<[f64; 3]>,
     /// Topology version the triangles were built from.
     pub topology_version: u64,
+    /// Per triangle, its connected part (triangles joined through shared edges, named by one of
+    /// them) if that part is open (has an edge a single triangle holds), else `None`; built with
+    /// the topology ([`open_parts`]).
+    pub open_part: Vec<Option<u32>>,
     /// Start and end of the step.
     pub t_a: f64,
     pub t_b: f64,
@@ -71,6 +75,7 @@ impl Surface {
         let (triangles, element_of, phi) = triangulate(elements, n_nodes)?;
         let zero = vec![[0.0; 3]; n_nodes];
         Ok(Surface {
+            open_part: open_parts(&triangles),
             triangles,
             element_of,
             phi,
@@ -93,6 +98,7 @@ impl Surface {
         version: u64,
     ) -> Result<(), SurfaceError> {
         (self.triangles, self.element_of, self.phi) = triangulate(elements, self.n_nodes())?;
+        self.open_part = open_parts(&self.triangles);
         self.topology_version = version;
         Ok(())
     }
@@ -184,6 +190,50 @@ impl Surface {
         }
         (px, pv)
     }
+}
+
+/// Per triangle, its connected part (triangles joined through shared edges, named by one of them)
+/// if that part is open (has an edge a single triangle holds), else `None`: union-find over the
+/// triangles' sorted edges.
+fn open_parts(triangles: &[[u32; 3]]) -> Vec<Option<u32>> {
+    let n = triangles.len();
+    let mut edges: Vec<([u32; 2], u32)> = Vec::with_capacity(3 * n);
+    for (t, tri) in triangles.iter().enumerate() {
+        for m in 0..3 {
+            let (a, b) = (tri[m], tri[(m + 1) % 3]);
+            edges.push(([a.min(b), a.max(b)], t as u32));
+        }
+    }
+    edges.sort_unstable();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let find = |parent: &mut Vec<u32>, mut a: u32| {
+        while parent[a as usize] != a {
+            parent[a as usize] = parent[parent[a as usize] as usize];
+            a = parent[a as usize];
+        }
+        a
+    };
+    let mut free = Vec::new();
+    for run in edges.chunk_by(|x, y| x.0 == y.0) {
+        if run.len() == 1 {
+            free.push(run[0].1);
+        }
+        for w in run.windows(2) {
+            let (a, b) = (find(&mut parent, w[0].1), find(&mut parent, w[1].1));
+            parent[a as usize] = b;
+        }
+    }
+    let mut open = vec![false; n];
+    for t in free {
+        let r = find(&mut parent, t);
+        open[r as usize] = true;
+    }
+    (0..n as u32)
+        .map(|t| {
+            let r = find(&mut parent, t);
+            open[r as usize].then_some(r)
+        })
+        .collect()
 }
 
 /// Splits `elements` into triangles over `n_nodes` nodes, checking node counts, indices and phi.

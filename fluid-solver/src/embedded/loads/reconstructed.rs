@@ -32,7 +32,6 @@
 use super::{distribute, or_zero, LoadView};
 use crate::embedded::riemann_fs::wall_normal_from_i;
 use crate::embedded::status::NO_SIDE;
-use crate::embedded::Surface;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::Cell;
 use rayon::prelude::*;
@@ -64,11 +63,12 @@ pub(super) fn vertex_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3],
 /// The cut cells with their cut edges: a pair `(cell, cut)` for every cell holding both ends of
 /// cut edge `cut`, ascending. Every cell with a cut edge appears, so every cell that can hold a
 /// polygon. The cells of an edge are the common entries of its ends' node-to-cell rows (both
-/// ascending: a merge, which reads no cell), found in parallel and sorted in parallel (the pairs
-/// are distinct, so the order is the same for any number of threads).
+/// ascending: a merge, which reads no cell), found in parallel and sorted in parallel as `u64`
+/// keys `cell << 32 | cut` (the pairs are distinct, so the order is the same for any number of
+/// threads).
 pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
     let adjacency = view.adjacency;
-    let mut pairs: Vec<(u32, u32)> = view
+    let mut keys: Vec<u64> = view
         .cuts
         .par_iter()
         .enumerate()
@@ -82,7 +82,7 @@ pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
                     std::cmp::Ordering::Less => x += 1,
                     std::cmp::Ordering::Greater => y += 1,
                     std::cmp::Ordering::Equal => {
-                        pairs.push((a[x], k as u32));
+                        pairs.push(u64::from(a[x]) << 32 | k as u64);
                         x += 1;
                         y += 1;
                     }
@@ -92,8 +92,8 @@ pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
         })
         .flatten_iter()
         .collect();
-    pairs.par_sort_unstable();
-    pairs
+    keys.par_sort_unstable();
+    keys.into_par_iter().map(|key| ((key >> 32) as u32, key as u32)).collect()
 }
 
 /// [`vertex_loads`] over the `(cell, cut)` pairs `pairs` (ascending), which must include every
@@ -117,12 +117,12 @@ pub(super) fn vertex_loads_in(
                 if cut_of.iter().flatten().count() < 3 {
                     continue;
                 }
-                for (cycle, walked) in cycles(cell, &cut_of) {
+                cycles(cell, &cut_of, |cycle, walked| {
                     polygon.clear();
                     polygon.extend(cycle.iter().map(|&k| vertex(view, k)));
                     orient(&mut polygon, walked);
                     integrate(view, &polygon, &mut |x, f, t, b| found.push((x, f, t, b)));
-                }
+                });
             }
             found
         })
@@ -142,7 +142,7 @@ const CELLS_PER_TASK: usize = 256;
 /// Per cut edge, whether it joins the reconstruction (see the module docs): its ends on different
 /// sides, or its triangle on a one-fluid shell.
 fn joining_cuts(view: &LoadView) -> Vec<bool> {
-    let part = open_parts(view.surface);
+    let part = &view.surface.open_part;
     // Per part: the first fluid side its cut edges reach, and whether they reach another.
     let mut reached: Vec<(u32, bool)> = vec![(NO_SIDE, false); part.len()];
     for c in view.cuts {
@@ -166,49 +166,6 @@ fn joining_cuts(view: &LoadView) -> Vec<bool> {
             let [i, j] = view.mesh.edges[c.edge as usize];
             let one_fluid_shell = part[c.triangle as usize].is_some_and(|r| !reached[r as usize].1);
             one_fluid_shell || view.side[i as usize] != view.side[j as usize]
-        })
-        .collect()
-}
-
-/// Per surface triangle, its connected part (triangles joined through shared edges, named by one
-/// of them) if that part is open (has an edge a single triangle holds), else `None`.
-fn open_parts(surface: &Surface) -> Vec<Option<u32>> {
-    let n = surface.triangles.len();
-    let mut edges: Vec<([u32; 2], u32)> = Vec::with_capacity(3 * n);
-    for (t, tri) in surface.triangles.iter().enumerate() {
-        for m in 0..3 {
-            let (a, b) = (tri[m], tri[(m + 1) % 3]);
-            edges.push(([a.min(b), a.max(b)], t as u32));
-        }
-    }
-    edges.sort_unstable();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    let find = |parent: &mut Vec<u32>, mut a: u32| {
-        while parent[a as usize] != a {
-            parent[a as usize] = parent[parent[a as usize] as usize];
-            a = parent[a as usize];
-        }
-        a
-    };
-    let mut free = Vec::new();
-    for run in edges.chunk_by(|x, y| x.0 == y.0) {
-        if run.len() == 1 {
-            free.push(run[0].1);
-        }
-        for w in run.windows(2) {
-            let (a, b) = (find(&mut parent, w[0].1), find(&mut parent, w[1].1));
-            parent[a as usize] = b;
-        }
-    }
-    let mut open = vec![false; n];
-    for t in free {
-        let r = find(&mut parent, t);
-        open[r as usize] = true;
-    }
-    (0..n as u32)
-        .map(|t| {
-            let r = find(&mut parent, t);
-            open[r as usize].then_some(r)
         })
         .collect()
 }
@@ -246,9 +203,10 @@ fn local_edge(cell: &Cell, a: usize, b: usize) -> usize {
     edges.iter().position(|&[p, q]| (p, q) == (a, b) || (p, q) == (b, a)).expect("a face edge")
 }
 
-/// The polygons of a cut cell as cycles of cut-edge indices, and whether they come from the face
-/// walk (`false`: the unordered points of a cell whose faces do not close; see the module docs).
-fn cycles(cell: &Cell, cut_of: &[Option<usize>; 12]) -> Vec<(Vec<usize>, bool)> {
+/// Calls `visit` with each polygon of a cut cell as a cycle of cut-edge indices, and whether it
+/// comes from the face walk (`false`: the unordered points of a cell whose faces do not close; see
+/// the module docs). No allocation: a cell has at most 12 edges.
+fn cycles(cell: &Cell, cut_of: &[Option<usize>; 12], mut visit: impl FnMut(&[usize], bool)) {
     // Neighbours of each local edge along the polygon, through the faces.
     let mut next: [[usize; 2]; 12] = [[usize::MAX; 2]; 12];
     let mut degree = [0usize; 12];
@@ -282,30 +240,38 @@ fn cycles(cell: &Cell, cut_of: &[Option<usize>; 12]) -> Vec<(Vec<usize>, bool)> 
             }
         }
     }
-    let cut_edges: Vec<usize> = (0..12).filter(|&l| cut_of[l].is_some()).collect();
+    let (mut cut_edges, mut n_cut) = ([0usize; 12], 0);
+    for l in (0..12).filter(|&l| cut_of[l].is_some()) {
+        cut_edges[n_cut] = l;
+        n_cut += 1;
+    }
+    let cut_edges = &cut_edges[..n_cut];
     closed &= cut_edges.iter().all(|&l| degree[l] == 2);
+    let mut cycle = [0usize; 12];
     if !closed {
-        return vec![(cut_edges.iter().map(|&l| cut_of[l].expect("cut")).collect(), false)];
+        for (c, &l) in cycle.iter_mut().zip(cut_edges) {
+            *c = cut_of[l].expect("cut");
+        }
+        return visit(&cycle[..n_cut], false);
     }
     let mut seen = [false; 12];
-    let mut out = Vec::new();
-    for &start in &cut_edges {
+    for &start in cut_edges {
         if seen[start] {
             continue;
         }
-        let mut cycle = vec![];
+        let mut len = 0;
         let (mut prev, mut cur) = (usize::MAX, start);
         while !seen[cur] {
             seen[cur] = true;
-            cycle.push(cut_of[cur].expect("cut"));
+            cycle[len] = cut_of[cur].expect("cut");
+            len += 1;
             let step = if next[cur][0] != prev { next[cur][0] } else { next[cur][1] };
             (prev, cur) = (cur, step);
         }
-        if cycle.len() >= 3 {
-            out.push((cycle, true));
+        if len >= 3 {
+            visit(&cycle[..len], true);
         }
     }
-    out
 }
 
 /// The polygon vertex of cut `k`: its intersection point and `q = p*_- - p*_+`, the `+` end the
