@@ -103,6 +103,9 @@ pub struct TrackingCase {
     pub near_edges_per_step: f64,
     pub swept_nodes_per_step: f64,
     pub changed_nodes_per_step: f64,
+    /// Rebuilds of the kept node-triangle pairs ([`crate::embedded::intersect::NearSkin`]) over
+    /// the timed steps.
+    pub skin_rebuilds: usize,
     pub measurements: Vec<TrackingMeasurement>,
 }
 
@@ -290,8 +293,12 @@ fn track(
     let mut split: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut full = BTreeMap::new();
     let mut counts = [0usize; 4];
+    let mut rebuilds_before_timing = 0;
     for k in 0..=steps {
         let timed = k > 0;
+        if k == 1 {
+            rebuilds_before_timing = run.tracker.near_skin.rebuilds;
+        }
         let (tracking0, loads0) = (run.tracking_s, run.loads_s);
         let start = Instant::now();
         let dt = run.step(&mut run_semi, &mut state, &mut ws, CFL, t, f64::INFINITY, None)?;
@@ -389,6 +396,7 @@ fn track(
         near_edges_per_step: mean(counts[1]),
         swept_nodes_per_step: mean(counts[2]),
         changed_nodes_per_step: mean(counts[3]),
+        skin_rebuilds: tracker.near_skin.rebuilds - rebuilds_before_timing,
         measurements: Vec::new(),
     };
     // Means, not medians: the kept pairs of the tracking rebuild on some steps only.

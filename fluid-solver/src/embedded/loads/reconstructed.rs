@@ -104,6 +104,9 @@ pub(super) fn vertex_loads_in(
     mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
     let joining = joining_cuts(view);
+    // Each cut's vertex once (about five cells share it).
+    let vertices: Vec<Vertex> =
+        (0..view.cuts.len()).into_par_iter().with_min_len(1024).map(|k| vertex(view, k)).collect();
     let cells: Vec<&[(u32, u32)]> = pairs.chunk_by(|a, b| a.0 == b.0).collect();
     // The cells' contributions in parallel, handed to `sink` in cell order (as one pass would).
     let per_chunk: Vec<Vec<Contribution>> = cells
@@ -119,7 +122,7 @@ pub(super) fn vertex_loads_in(
                 }
                 cycles(cell, &cut_of, |cycle, walked| {
                     polygon.clear();
-                    polygon.extend(cycle.iter().map(|&k| vertex(view, k)));
+                    polygon.extend(cycle.iter().map(|&k| vertices[k]));
                     orient(&mut polygon, walked);
                     integrate(view, &polygon, &mut |x, f, t, b| found.push((x, f, t, b)));
                 });
