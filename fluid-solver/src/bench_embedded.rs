@@ -230,6 +230,7 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
         + std::mem::size_of_val(&s.element_of[..])
         + std::mem::size_of_val(&s.phi[..])
         + std::mem::size_of_val(&s.open_part[..])
+        + s.edges.memory_bytes()
         + 4 * std::mem::size_of_val(&s.x_a[..]);
     split.insert("tracker".to_string(), tracker.memory_bytes());
     split.insert("surface".to_string(), surface_bytes);

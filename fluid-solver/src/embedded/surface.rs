@@ -21,9 +21,11 @@ pub struct Surface {
     pub phi: Vec<[f64; 3]>,
     /// Topology version the triangles were built from.
     pub topology_version: u64,
+    /// The surface's edges, each with the triangle sides that hold it; built with the topology.
+    pub edges: SurfaceEdges,
     /// Per triangle, its connected part (triangles joined through shared edges, named by one of
     /// them) if that part is open (has an edge a single triangle holds), else `None`; built with
-    /// the topology ([`open_parts`]).
+    /// the topology ([`SurfaceEdges::open_parts`]).
     pub open_part: Vec<Option<u32>>,
     /// Start and end of the step.
     pub t_a: f64,
@@ -74,8 +76,10 @@ impl Surface {
         let n_nodes = x.len();
         let (triangles, element_of, phi) = triangulate(elements, n_nodes)?;
         let zero = vec![[0.0; 3]; n_nodes];
+        let edges = SurfaceEdges::new(&triangles);
         Ok(Surface {
-            open_part: open_parts(&triangles),
+            open_part: edges.open_parts(triangles.len()),
+            edges,
             triangles,
             element_of,
             phi,
@@ -98,7 +102,8 @@ impl Surface {
         version: u64,
     ) -> Result<(), SurfaceError> {
         (self.triangles, self.element_of, self.phi) = triangulate(elements, self.n_nodes())?;
-        self.open_part = open_parts(&self.triangles);
+        self.edges = SurfaceEdges::new(&self.triangles);
+        self.open_part = self.edges.open_parts(self.triangles.len());
         self.topology_version = version;
         Ok(())
     }
@@ -192,48 +197,79 @@ impl Surface {
     }
 }
 
-/// Per triangle, its connected part (triangles joined through shared edges, named by one of them)
-/// if that part is open (has an edge a single triangle holds), else `None`: union-find over the
-/// triangles' sorted edges.
-fn open_parts(triangles: &[[u32; 3]]) -> Vec<Option<u32>> {
-    let n = triangles.len();
-    let mut edges: Vec<([u32; 2], u32)> = Vec::with_capacity(3 * n);
-    for (t, tri) in triangles.iter().enumerate() {
-        for m in 0..3 {
-            let (a, b) = (tri[m], tri[(m + 1) % 3]);
-            edges.push(([a.min(b), a.max(b)], t as u32));
+/// The edges of a triangulated surface: each distinct node pair with the triangle sides holding
+/// it, `(triangle, k)` for the side opposite corner `k`; one on a free edge, two on a manifold
+/// edge, more where sheets meet.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SurfaceEdges {
+    /// Edge `m` is held by `sides[offsets[m]..offsets[m + 1]]`.
+    offsets: Vec<u32>,
+    sides: Vec<(u32, u8)>,
+}
+
+impl SurfaceEdges {
+    /// The edges of `triangles`, by sorting their sides by node pair.
+    pub fn new(triangles: &[[u32; 3]]) -> SurfaceEdges {
+        let mut keys: Vec<([u32; 2], u32, u8)> = Vec::with_capacity(3 * triangles.len());
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3u8 {
+                let (a, b) = (tri[(k as usize + 1) % 3], tri[(k as usize + 2) % 3]);
+                keys.push(([a.min(b), a.max(b)], t as u32, k));
+            }
         }
+        keys.sort_unstable();
+        let mut offsets = vec![0];
+        for run in keys.chunk_by(|x, y| x.0 == y.0) {
+            offsets.push(offsets.last().copied().unwrap_or(0) + run.len() as u32);
+        }
+        let sides = keys.into_iter().map(|(_, t, k)| (t, k)).collect();
+        SurfaceEdges { offsets, sides }
     }
-    edges.sort_unstable();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    let find = |parent: &mut Vec<u32>, mut a: u32| {
-        while parent[a as usize] != a {
-            parent[a as usize] = parent[parent[a as usize] as usize];
-            a = parent[a as usize];
-        }
-        a
-    };
-    let mut free = Vec::new();
-    for run in edges.chunk_by(|x, y| x.0 == y.0) {
-        if run.len() == 1 {
-            free.push(run[0].1);
-        }
-        for w in run.windows(2) {
-            let (a, b) = (find(&mut parent, w[0].1), find(&mut parent, w[1].1));
-            parent[a as usize] = b;
-        }
+
+    /// Each edge's triangle sides.
+    pub fn runs(&self) -> impl Iterator<Item = &[(u32, u8)]> {
+        self.offsets.windows(2).map(|w| &self.sides[w[0] as usize..w[1] as usize])
     }
-    let mut open = vec![false; n];
-    for t in free {
-        let r = find(&mut parent, t);
-        open[r as usize] = true;
-    }
-    (0..n as u32)
-        .map(|t| {
+
+    /// Per triangle (of `n`), its connected part (triangles joined through shared edges, named
+    /// by one of them) if that part is open (has an edge a single triangle holds), else `None`:
+    /// union-find over the edges.
+    pub fn open_parts(&self, n: usize) -> Vec<Option<u32>> {
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        let find = |parent: &mut Vec<u32>, mut a: u32| {
+            while parent[a as usize] != a {
+                parent[a as usize] = parent[parent[a as usize] as usize];
+                a = parent[a as usize];
+            }
+            a
+        };
+        let mut free = Vec::new();
+        for run in self.runs() {
+            if run.len() == 1 {
+                free.push(run[0].0);
+            }
+            for w in run.windows(2) {
+                let (a, b) = (find(&mut parent, w[0].0), find(&mut parent, w[1].0));
+                parent[a as usize] = b;
+            }
+        }
+        let mut open = vec![false; n];
+        for t in free {
             let r = find(&mut parent, t);
-            open[r as usize].then_some(r)
-        })
-        .collect()
+            open[r as usize] = true;
+        }
+        (0..n as u32)
+            .map(|t| {
+                let r = find(&mut parent, t);
+                open[r as usize].then_some(r)
+            })
+            .collect()
+    }
+
+    /// Memory in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(&self.offsets[..]) + std::mem::size_of_val(&self.sides[..])
+    }
 }
 
 /// Splits `elements` into triangles over `n_nodes` nodes, checking node counts, indices and phi.

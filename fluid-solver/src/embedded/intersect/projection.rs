@@ -322,35 +322,39 @@ impl<'a> PseudoNormals<'a> {
     fn new(at: SurfaceAt<'a>) -> PseudoNormals<'a> {
         let tris = &at.surface.triangles;
         let face: Vec<[f64; 3]> = (0..tris.len() as u32)
+            .into_par_iter()
+            .with_min_len(1024)
             .map(|t| {
                 let [a, b, c] = at.corners(t);
                 unit_normal(a, b, c)
             })
             .collect();
+        // Each corner's share of its vertex normal (the face normal times the corner angle), in
+        // parallel, then summed per vertex in triangle order.
+        let shares: Vec<[[f64; 3]; 3]> = (0..tris.len() as u32)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|t| {
+                let c = at.corners(t);
+                [0, 1, 2].map(|k| {
+                    let (u, w) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
+                    scale(face[t as usize], norm(cross(u, w)).atan2(dot(u, w)))
+                })
+            })
+            .collect();
         let mut vertex = vec![[0.0; 3]; at.x.len()];
-        for (t, tri) in tris.iter().enumerate() {
-            let c = at.corners(t as u32);
+        for (tri, share) in tris.iter().zip(&shares) {
             for k in 0..3 {
-                let (u, w) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
-                let angle = norm(cross(u, w)).atan2(dot(u, w));
                 let v = tri[k] as usize;
-                vertex[v] = add(vertex[v], scale(face[t], angle));
+                vertex[v] = add(vertex[v], share[k]);
             }
         }
-        // Edge normals: the faces sharing each (sorted) node pair, summed.
-        let mut keys: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * tris.len());
-        for (t, tri) in tris.iter().enumerate() {
-            for k in 0..3u8 {
-                let (a, b) = (tri[(k as usize + 1) % 3], tri[(k as usize + 2) % 3]);
-                keys.push((a.min(b), a.max(b), t as u32, k));
-            }
-        }
-        keys.sort_unstable();
+        // Edge normals: the faces sharing each edge, summed.
         let mut edge = vec![[[0.0; 3]; 3]; tris.len()];
-        for run in keys.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-            let n = run.iter().fold([0.0; 3], |s, r| add(s, face[r.2 as usize]));
-            for r in run {
-                edge[r.2 as usize][r.3 as usize] = n;
+        for run in at.surface.edges.runs() {
+            let n = run.iter().fold([0.0; 3], |s, &(t, _)| add(s, face[t as usize]));
+            for &(t, k) in run {
+                edge[t as usize][k as usize] = n;
             }
         }
         PseudoNormals { face, edge, vertex, triangles: tris }
