@@ -32,6 +32,7 @@ use crate::time::cfl::stable_time_step;
 use crate::time::rk2::rk2_step_embedded;
 use interface_protocol::case::{InterfaceTreatment, LoadAlgorithm};
 use interface_protocol::io::probes::ProbeWriter;
+use rayon::prelude::*;
 use std::path::Path;
 
 /// Where the surface's nodal states at the end of each fluid step come from.
@@ -111,11 +112,20 @@ pub struct MassBalance {
     pub change: f64,
 }
 
-/// `Σ |C_i| ρ_i` over the nodes with `active[i]`.
+/// `Σ |C_i| ρ_i` over the nodes with `active[i]`, summed by fixed chunks (the same for any
+/// number of threads).
 pub fn active_mass(semi: &Semidiscretization, cons: &[[f64; 5]], active: &[bool]) -> f64 {
     let volumes = &semi.mesh.volumes;
-    (0..cons.len()).filter(|&i| active[i]).map(|i| volumes[i] * cons[i][0]).sum()
+    let chunk = |c: usize| {
+        let range = c * MASS_CHUNK..((c + 1) * MASS_CHUNK).min(cons.len());
+        range.filter(|&i| active[i]).map(|i| volumes[i] * cons[i][0]).sum::<f64>()
+    };
+    let sums: Vec<f64> = (0..cons.len().div_ceil(MASS_CHUNK)).into_par_iter().map(chunk).collect();
+    sums.iter().sum()
 }
+
+/// Nodes per partial sum of [`active_mass`].
+const MASS_CHUNK: usize = 8192;
 
 /// The level set of a step with the surface: its settings and scratch, and the number of this
 /// step from 1 (for the reinitialisation).
@@ -219,11 +229,11 @@ impl EmbeddedRun {
         let tracker = &self.tracker;
         let dt_cfl = ws
             .dt_node
-            .iter()
+            .par_iter()
             .zip(&tracker.active)
             .filter(|(_, a)| **a)
             .map(|(d, _)| *d)
-            .fold(f64::INFINITY, f64::min);
+            .reduce(|| f64::INFINITY, f64::min);
         // Thesis §4.4: the surface moves at most half of its nearest edge in a step, from the speed
         // at the start of the step.
         let h = tracker.adjacency.h_min.iter().copied().fold(f64::INFINITY, f64::min);
