@@ -172,10 +172,21 @@ impl EmbeddedStep {
         self.gradient.remask(mesh, &flipped, |i| tracker.adjacency.edges_of(i));
         // The frozen and dead edges that were not looked at stay as they were.
         let kept = |list: &[u32], now: Vec<u32>| {
-            let mut kept: Vec<u32> =
-                list.iter().copied().filter(|e| edges.binary_search(e).is_err()).collect();
+            // Both ascending: those of `list` not in `edges` by one merge, then `now` merged in.
+            let mut looked = edges.iter().peekable();
+            let unlooked = list.iter().copied().filter(|e| {
+                while looked.next_if(|l| *l < e).is_some() {}
+                looked.peek() != Some(&e)
+            });
+            let mut kept = Vec::with_capacity(list.len() + now.len());
+            let mut now = now.into_iter().peekable();
+            for e in unlooked {
+                while let Some(n) = now.next_if(|n| *n < e) {
+                    kept.push(n);
+                }
+                kept.push(e);
+            }
             kept.extend(now);
-            kept.sort_unstable();
             kept
         };
         let frozen = kept(&self.frozen, frozen_now);

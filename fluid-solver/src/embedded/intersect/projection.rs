@@ -46,28 +46,35 @@ pub fn projection_near(
     at: SurfaceAt<'_>,
     near: &Near,
 ) -> Intersections {
-    whole_mesh(mesh, adjacency, at, near).2
+    whole_mesh(mesh, adjacency, at, near).3
 }
 
 /// Per node: inside the closed surface (Alg. 4.1 steps 1-4).
 pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Vec<bool> {
     let all = Near::all(mesh);
-    flood(mesh, adjacency, &all.nodes, decide(mesh, adjacency, at, &all))
+    flood(mesh, adjacency, &all.nodes, sides(&decide(mesh, adjacency, at, &all, &all.nodes)))
 }
 
-/// Steps 1-4 over the whole mesh from the near nodes: the inside of every node, the edges whose
-/// ends differ (ascending) and the cut edges.
+/// Steps 1-4 over the whole mesh from the near nodes: the decisions of the near nodes (with
+/// their distances to the surface), the inside of every node, the edges whose ends differ
+/// (ascending) and the cut edges.
 fn whole_mesh(
     mesh: &Mesh,
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
     near: &Near,
-) -> (Vec<bool>, Vec<u32>, Intersections) {
-    let inside = flood(mesh, adjacency, &near.nodes, decide(mesh, adjacency, at, near));
+) -> (Vec<Option<(bool, f64)>>, Vec<bool>, Vec<u32>, Intersections) {
+    let decided = decide(mesh, adjacency, at, near, &near.nodes);
+    let inside = flood(mesh, adjacency, &near.nodes, sides(&decided));
     let differ: Vec<u32> =
         (0..mesh.n_edges() as u32).filter(|&e| differs(mesh, &inside, e)).collect();
     let cuts = cut_edges(mesh, adjacency, at, near, &differ);
-    (inside, differ, cuts)
+    (decided, inside, differ, cuts)
+}
+
+/// The sides of decisions with distances.
+fn sides(decided: &[Option<(bool, f64)>]) -> Vec<Option<bool>> {
+    decided.iter().map(|d| d.map(|d| d.0)).collect()
 }
 
 /// Alg. 4.1 from step to step at the cost of the surface (the tracker's form of
@@ -85,9 +92,23 @@ fn whole_mesh(
 /// touches a node of `D`) or kept as differing from the last step; where one fails the step
 /// takes the whole-mesh flood fill instead ([`KeptInside::full_fills`] counts them). Step 5 then
 /// tests only the differing edges, all of them near.
+///
+/// A near node is not redecided while the surface cannot have reached it: a node at distance `d`
+/// from a closed surface keeps its side while the surface moves less than `d` (every surface point
+/// is a convex combination of the nodes, so it moves at most the largest nodal displacement, and
+/// along the straight path between the two positions the surface never touches the node, whose
+/// winding number therefore stays). The type keeps the distance travelled by the surface (the sum
+/// of the largest nodal displacement of each step) and, per node, the travelled distance up to
+/// which its last decision holds; only nodes past it, or never decided, run steps 1-3. Only on
+/// surfaces whose every part is closed (on others the projection's side is no winding number).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KeptInside {
     inside: Vec<bool>,
+    /// Per node, the travelled distance up to which its side holds (0: redecide); see above.
+    holds_until: Vec<f64>,
+    /// The surface's positions at the last step and the distance it travelled since the start.
+    last_x: Vec<[f64; 3]>,
+    travelled: f64,
     /// Edges whose ends differ, ascending.
     differ: Vec<u32>,
     /// Connected part of the mesh of each node, and their number.
@@ -95,6 +116,9 @@ pub struct KeptInside {
     n_parts: usize,
     /// Steps that fell back on the whole-mesh flood fill.
     pub full_fills: usize,
+    /// Near nodes redecided, and near nodes that kept their side, over the steps.
+    pub redecided: usize,
+    pub kept: usize,
 }
 
 impl KeptInside {
@@ -105,9 +129,29 @@ impl KeptInside {
         at: SurfaceAt<'_>,
         near: &Near,
     ) -> (KeptInside, Intersections) {
-        let (inside, differ, cuts) = whole_mesh(mesh, adjacency, at, near);
+        let (decided, inside, differ, cuts) = whole_mesh(mesh, adjacency, at, near);
+        let mut holds_until = vec![0.0; mesh.n_nodes()];
+        let closed = at.surface.open_part.iter().all(Option::is_none);
+        for (&i, d) in near.nodes.iter().zip(&decided) {
+            if let (Some((_, clearance)), true) = (d, closed) {
+                holds_until[i as usize] = clearance * (1.0 - 1e-9);
+            }
+        }
         let (part, n_parts) = connected_parts(mesh, adjacency);
-        (KeptInside { inside, differ, part, n_parts, full_fills: 0 }, cuts)
+        let last_x = at.x.to_vec();
+        let kept = KeptInside {
+            inside,
+            holds_until,
+            last_x,
+            travelled: 0.0,
+            differ,
+            part,
+            n_parts,
+            full_fills: 0,
+            redecided: 0,
+            kept: 0,
+        };
+        (kept, cuts)
     }
 
     /// The cuts of the next step ([`projection_near`] at the surface `at`, whose swept boxes give
@@ -119,7 +163,7 @@ impl KeptInside {
         at: SurfaceAt<'_>,
         near: &Near,
     ) -> Intersections {
-        let decided = decide(mesh, adjacency, at, near);
+        let decided = self.decide_moved(mesh, adjacency, at, near);
         if !self.update_near(mesh, near, &decided) {
             self.full_fills += 1;
             self.inside = flood(mesh, adjacency, &near.nodes, decided);
@@ -127,6 +171,52 @@ impl KeptInside {
                 (0..mesh.n_edges() as u32).filter(|&e| differs(mesh, &self.inside, e)).collect();
         }
         cut_edges(mesh, adjacency, at, near, &self.differ)
+    }
+
+    /// Steps 1-3 at the near nodes the surface may have reached since their last decision (see
+    /// the type's docs); the others keep their side.
+    fn decide_moved(
+        &mut self,
+        mesh: &Mesh,
+        adjacency: &NodeEdges,
+        at: SurfaceAt<'_>,
+        near: &Near,
+    ) -> Vec<Option<bool>> {
+        let closed = at.surface.open_part.iter().all(Option::is_none);
+        if !closed || at.x.len() != self.last_x.len() {
+            self.holds_until.iter_mut().for_each(|h| *h = 0.0);
+        } else {
+            let moved = at.x.iter().zip(&self.last_x).map(|(a, b)| norm(sub(*a, *b)));
+            // Rounded up: the bound must not fall short.
+            self.travelled += moved.fold(0.0, f64::max) * (1.0 + 1e-9);
+        }
+        self.last_x = at.x.to_vec();
+        let travelled = self.travelled;
+        let redo: Vec<u32> = near
+            .nodes
+            .iter()
+            .copied()
+            .filter(|&i| self.holds_until[i as usize] <= travelled)
+            .collect();
+        let decided = decide(mesh, adjacency, at, near, &redo);
+        self.redecided += redo.len();
+        self.kept += near.nodes.len() - redo.len();
+        for (&i, d) in redo.iter().zip(&decided) {
+            let i = i as usize;
+            self.holds_until[i] = match (d, closed) {
+                (Some((_, clearance)), true) => travelled + clearance * (1.0 - 1e-9),
+                _ => 0.0,
+            };
+        }
+        // Back in the order of `near.nodes`: the kept side where not redecided.
+        let mut redone = redo.iter().zip(decided).peekable();
+        near.nodes
+            .iter()
+            .map(|&i| match redone.peek() {
+                Some((&j, _)) if j == i => redone.next().and_then(|(_, d)| d.map(|d| d.0)),
+                _ => Some(self.inside[i as usize]),
+            })
+            .collect()
     }
 
     /// Sets the decided near nodes and checks (a) and (b) of the type's docs; on success the
@@ -163,7 +253,11 @@ impl KeptInside {
     /// Memory in bytes.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of_val;
-        size_of_val(&self.inside[..]) + size_of_val(&self.differ[..]) + size_of_val(&self.part[..])
+        size_of_val(&self.inside[..])
+            + size_of_val(&self.holds_until[..])
+            + size_of_val(&self.last_x[..])
+            + size_of_val(&self.differ[..])
+            + size_of_val(&self.part[..])
     }
 }
 
@@ -235,12 +329,22 @@ fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, near: &Near, e: usize) -> Option<Cut
     Some(at.cut(e, t, alpha, cp.bary))
 }
 
-/// Steps 1-3 at the nodes of `near`: each near node decided by its closest point (`None` for a
-/// node whose box meets no triangle box: left to the flood fill).
-fn decide(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>, near: &Near) -> Vec<Option<bool>> {
+/// Steps 1-3 at the near nodes `nodes` (ascending, all in `near`): each decided by its closest
+/// point, with its distance to the surface (`None` for a node whose box meets no triangle box:
+/// left to the flood fill).
+fn decide(
+    mesh: &Mesh,
+    adjacency: &NodeEdges,
+    at: SurfaceAt<'_>,
+    near: &Near,
+    nodes: &[u32],
+) -> Vec<Option<(bool, f64)>> {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
+    if nodes.is_empty() {
+        return Vec::new();
+    }
     let normals = PseudoNormals::new(at);
-    near.nodes
+    nodes
         .par_iter()
         .map(|&i| {
             let i = i as usize;
@@ -276,7 +380,7 @@ fn decide(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>, near: &Near) ->
             }
             let [a, b, c] = at.corners(t);
             let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
-            Some(dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0)
+            Some((dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0, cp.dist2.sqrt()))
         })
         .collect()
 }
@@ -417,9 +521,9 @@ mod tests {
             let want: Vec<Option<bool>> =
                 near.nodes.iter().map(|&i| decide_unpruned(&mesh, &adj, at, i as usize)).collect();
             assert!(want.iter().filter(|d| d.is_some()).count() > 100);
-            assert_eq!(decide(&mesh, &adj, at, &near), want);
+            assert_eq!(sides(&decide(&mesh, &adj, at, &near, &near.nodes)), want);
             let all = Near::all(&mesh);
-            let full = decide(&mesh, &adj, at, &all);
+            let full = sides(&decide(&mesh, &adj, at, &all, &all.nodes));
             for (&i, w) in near.nodes.iter().zip(&want) {
                 assert_eq!(full[i as usize], *w, "node {i}");
             }
