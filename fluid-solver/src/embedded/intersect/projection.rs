@@ -55,6 +55,9 @@ pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) 
     flood(mesh, adjacency, &all.nodes, sides(&decide(mesh, adjacency, at, &all, &all.nodes)))
 }
 
+/// A near node's side (`true`: inside) and its distance to the surface, if decided.
+type Decision = Option<(bool, f64)>;
+
 /// Steps 1-4 over the whole mesh from the near nodes: the decisions of the near nodes (with
 /// their distances to the surface), the inside of every node, the edges whose ends differ
 /// (ascending) and the cut edges.
@@ -63,7 +66,7 @@ fn whole_mesh(
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
     near: &Near,
-) -> (Vec<Option<(bool, f64)>>, Vec<bool>, Vec<u32>, Intersections) {
+) -> (Vec<Decision>, Vec<bool>, Vec<u32>, Intersections) {
     let decided = decide(mesh, adjacency, at, near, &near.nodes);
     let inside = flood(mesh, adjacency, &near.nodes, sides(&decided));
     let differ: Vec<u32> =
@@ -73,7 +76,7 @@ fn whole_mesh(
 }
 
 /// The sides of decisions with distances.
-fn sides(decided: &[Option<(bool, f64)>]) -> Vec<Option<bool>> {
+fn sides(decided: &[Decision]) -> Vec<Option<bool>> {
     decided.iter().map(|d| d.map(|d| d.0)).collect()
 }
 
@@ -338,7 +341,7 @@ fn decide(
     at: SurfaceAt<'_>,
     near: &Near,
     nodes: &[u32],
-) -> Vec<Option<(bool, f64)>> {
+) -> Vec<Decision> {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     if nodes.is_empty() {
         return Vec::new();
