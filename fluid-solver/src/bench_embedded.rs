@@ -15,8 +15,8 @@
 //! - the wall fluxes (Alg. 5.1, `add_wall_fluxes`) over every cut edge of the cylinder, one
 //!   thread: nanoseconds per cut edge and the share of one single-material residual;
 //! - bytes per node of the embedded state (tracker arrays and the hierarchy over the mesh nodes,
-//!   surface, surface hierarchy, the step view, the per-node material index the wall fluxes read
-//!   and the cut mask the fill reads);
+//!   surface, surface hierarchy, the step view and the per-node material index the wall fluxes
+//!   read);
 //! - the load average of the machine before and after (the machine may be shared: compare the
 //!   ratios, which are measured side by side).
 
@@ -76,7 +76,7 @@ pub struct TrackingMeasurement {
     pub loads_seconds: f64,
     /// The parts of the tracking: `refit` (surface advance + hierarchy refit), `near` (the mesh
     /// nodes and edges the swept boxes reach), `intersect` (Alg. 4.1 or 4.2 over them),
-    /// `swept_nodes`, `update_sides`, `fill` (cut mask + `fill_changed`), `step_update` (the
+    /// `swept_nodes`, `update_sides`, `fill` (`fill_changed`), `step_update` (the
     /// step view and its masked gradient, updated).
     pub tracking_split_seconds: BTreeMap<String, f64>,
     /// At the last step: `intersect` over every node and edge, and `step_new` (the step view and
@@ -237,7 +237,6 @@ pub fn run(nodes: usize, steps: usize, fluid: &BenchReport) -> anyhow::Result<Em
     split.insert("bvh".to_string(), tracker.bvh.memory_bytes());
     split.insert("step_view".to_string(), step.memory_bytes());
     split.insert("material".to_string(), mesh.n_nodes());
-    split.insert("cut_mask".to_string(), mesh.n_edges());
     let per_node = |b: usize| b as f64 / mesh.n_nodes() as f64;
     let bytes_per_node = per_node(split.values().sum());
     Ok(EmbeddedReport {
@@ -335,8 +334,8 @@ fn track(
         stamp("swept_nodes", &mut lap);
         let changes = parts.move_sides(mesh, cuts, &swept, &near);
         stamp("update_sides", &mut lap);
-        let cut = parts.cuts.cut_mask(mesh.n_edges());
-        let moved = Swept::new(mesh, &parts.adjacency, &changes, &parts.sides, &was_active, &cut);
+        let moved =
+            Swept::new(mesh, &parts.adjacency, &changes, &parts.sides, &was_active, &parts.cuts);
         let filled = fill_changed(&moved, &ws.prim, |_, _| true, true)?;
         std::hint::black_box(filled);
         stamp("fill", &mut lap);

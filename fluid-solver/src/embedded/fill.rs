@@ -162,9 +162,15 @@ mod tests {
             !gained.is_empty()
                 && gained.iter().all(|&i| (mesh.coords[i as usize][0] - 0.6).abs() < 1e-12)
         );
-        let cut = tracker.cuts.cut_mask(mesh.n_edges());
         let filled = fill_changed(
-            &Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut),
+            &Swept::new(
+                &mesh,
+                &tracker.adjacency,
+                &changes,
+                &tracker.sides,
+                &was_active,
+                &tracker.cuts,
+            ),
             &prim,
             |_, _| true,
             false,
@@ -180,7 +186,14 @@ mod tests {
             .collect();
         for linear in [false, true] {
             let filled = fill_changed(
-                &Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut),
+                &Swept::new(
+                    &mesh,
+                    &tracker.adjacency,
+                    &changes,
+                    &tracker.sides,
+                    &was_active,
+                    &tracker.cuts,
+                ),
                 &prim,
                 |_, _| true,
                 linear,
@@ -204,9 +217,15 @@ mod tests {
         .unwrap();
         let s2 = wall(0.95);
         let changes = tracker.advance(&mesh, 0.4, &s2.x, &v).unwrap();
-        let cut = tracker.cuts.cut_mask(mesh.n_edges());
         let e = fill_changed(
-            &Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut),
+            &Swept::new(
+                &mesh,
+                &tracker.adjacency,
+                &changes,
+                &tracker.sides,
+                &was_active,
+                &tracker.cuts,
+            ),
             &prim,
             |_, _| true,
             true,

@@ -77,9 +77,14 @@ mod tests {
         let s1 = wall(0.61);
         let v = vec![[1.0, 0.0, 0.0]; s1.x.len()];
         let changes = tracker.advance(&mesh, 0.06, &s1.x, &v).unwrap();
-        let cut = tracker.cuts.cut_mask(mesh.n_edges());
-        let swept =
-            Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut);
+        let swept = Swept::new(
+            &mesh,
+            &tracker.adjacency,
+            &changes,
+            &tracker.sides,
+            &was_active,
+            &tracker.cuts,
+        );
         let new = side_materials(&swept, &material).expect("the swept nodes change fluid");
         let passed: Vec<usize> = (0..mesh.n_nodes()).filter(|&i| new[i] != material[i]).collect();
         assert!(!passed.is_empty());
@@ -92,9 +97,14 @@ mod tests {
         // Nothing moves: no change of fluid.
         let was_active = tracker.active.clone();
         let changes = tracker.advance(&mesh, 0.07, &s1.x, &vec![[0.0; 3]; s1.x.len()]).unwrap();
-        let cut = tracker.cuts.cut_mask(mesh.n_edges());
-        let swept =
-            Swept::new(&mesh, &tracker.adjacency, &changes, &tracker.sides, &was_active, &cut);
+        let swept = Swept::new(
+            &mesh,
+            &tracker.adjacency,
+            &changes,
+            &tracker.sides,
+            &was_active,
+            &tracker.cuts,
+        );
         let same = side_materials(&swept, &new);
         assert_eq!(same, None);
     }

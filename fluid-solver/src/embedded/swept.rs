@@ -5,33 +5,34 @@
 //! after the step and not changed in it. Built once per step and shared by all three.
 
 use super::adjacency::NodeEdges;
+use super::intersect::Intersections;
 use super::status::{NodeSides, NodeStatus, SideChange};
 use crate::mesh::Mesh;
 
-/// A step's side changes with the mesh, the new sides and cut mask and the old activity.
+/// A step's side changes with the mesh, the new sides and cut edges and the old activity.
 pub struct Swept<'a> {
     pub mesh: &'a Mesh,
     adjacency: &'a NodeEdges,
     changes: &'a [SideChange],
     pub sides: &'a NodeSides,
     was_active: &'a [bool],
-    cut: &'a [bool],
+    cuts: &'a Intersections,
     changed: std::collections::HashSet<u32>,
 }
 
 impl<'a> Swept<'a> {
-    /// `changes` of the step, the new `sides` and per-edge `cut` mask, and each node's status
-    /// before the step, `was_active`.
+    /// `changes` of the step, the new `sides` and cut edges `cuts` (searched, edge by edge, only
+    /// around the few changed nodes), and each node's status before the step, `was_active`.
     pub fn new(
         mesh: &'a Mesh,
         adjacency: &'a NodeEdges,
         changes: &'a [SideChange],
         sides: &'a NodeSides,
         was_active: &'a [bool],
-        cut: &'a [bool],
+        cuts: &'a Intersections,
     ) -> Swept<'a> {
         let changed = changes.iter().map(|c| c.node).collect();
-        Swept { mesh, adjacency, changes, sides, was_active, cut, changed }
+        Swept { mesh, adjacency, changes, sides, was_active, cuts, changed }
     }
 
     /// The changed nodes that are active now, in the order of the changes.
@@ -44,7 +45,7 @@ impl<'a> Swept<'a> {
     pub fn same_side(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
         let side = self.sides.side[i];
         self.adjacency.neighbours(self.mesh, i).filter_map(move |(j, e)| {
-            (!self.cut[e as usize] && self.sides.side[j] == side).then_some(j)
+            (self.sides.side[j] == side && self.cuts.find(e).is_none()).then_some(j)
         })
     }
 
