@@ -241,15 +241,24 @@ fn special_edges(
     dead: &[u32],
     cut: &[u32],
 ) -> SpecialEdges {
+    // The three lists are disjoint: one merge of the three into one sorted list.
+    let mut lists =
+        [(dead, SpecialKind::Dead), (frozen, SpecialKind::Frozen), (cut, SpecialKind::Cut)].map(
+            |(edges, kind)| edges.iter().map(move |&edge| SpecialEdge { edge, kind }).peekable(),
+        );
+    let mut list = Vec::with_capacity(dead.len() + frozen.len() + cut.len());
+    loop {
+        let next =
+            lists.iter_mut().enumerate().filter_map(|(k, l)| l.peek().map(|s| (s.edge, k))).min();
+        let Some((_, k)) = next else { break };
+        list.extend(lists[k].next());
+    }
     let blocks = &semi.mesh.blocks;
-    let list = |edges: &[u32], kind| {
-        let list = edges.iter().map(|&edge| SpecialEdge { edge, kind }).collect();
-        SpecialEdges::from_sorted(blocks, list)
-    };
-    semi.special_edges()
-        .merge(&list(dead, SpecialKind::Dead), blocks)
-        .merge(&list(frozen, SpecialKind::Frozen), blocks)
-        .merge(&list(cut, SpecialKind::Cut), blocks)
+    let ours = SpecialEdges::from_sorted(blocks, list);
+    match semi.special_edges() {
+        scheme if scheme.is_empty() => ours,
+        scheme => scheme.merge(&ours, blocks),
+    }
 }
 
 /// The embedded boundary at one stage time, as the residual reads it.
