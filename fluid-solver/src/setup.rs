@@ -106,6 +106,7 @@ pub fn mesh(case: &Case) -> anyhow::Result<Mesh> {
                 hi: b.hi,
                 cells: b.cells,
                 grading: b.grading,
+                core: b.core,
                 shape: match b.shape {
                     BoxShape::Hex => BoxCells::Hex,
                     BoxShape::Tet => BoxCells::Tet,

@@ -12,6 +12,7 @@ fn graded(shape: BoxCells) -> BoxSpec {
         hi: [1.0, 0.5, 3.0],
         cells: [7, 4, 5],
         grading: [1.2, 0.8, 1.0],
+        core: [3, 0, 2],
         shape,
     }
 }
@@ -57,6 +58,29 @@ fn box_meshes_are_closed_and_fill_the_domain() {
         let s: f64 = xmax.normals.iter().map(|n| n[0]).sum();
         assert!((s - 0.5).abs() < 1e-13, "{s}");
     }
+}
+
+/// A core of equal cells, then geometric grading: along x of [`graded`], cells 1-3 equal and each
+/// after them 1.2 times the previous; along z cells 1-2 equal, then uniform; along y (no core)
+/// every cell 0.8 times the previous.
+#[test]
+fn a_box_core_has_equal_cells_then_grades() {
+    let mesh = Mesh::build(graded(BoxCells::Hex).raw().unwrap()).unwrap();
+    let axis = |d: usize| {
+        let mut x: Vec<f64> = mesh.coords.iter().map(|c| c[d]).collect();
+        x.sort_by(f64::total_cmp);
+        x.dedup();
+        x.windows(2).map(|w| w[1] - w[0]).collect::<Vec<f64>>()
+    };
+    let (hx, hy, hz) = (axis(0), axis(1), axis(2));
+    assert_eq!((hx.len(), hy.len(), hz.len()), (7, 4, 5));
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-12 * b.abs();
+    assert!(close(hx[1], hx[0]) && close(hx[2], hx[0]), "{hx:?}");
+    assert!((3..7).all(|k| close(hx[k], 1.2 * hx[k - 1])), "{hx:?}");
+    assert!((1..4).all(|k| close(hy[k], 0.8 * hy[k - 1])), "{hy:?}");
+    assert!(hz.iter().all(|&h| close(h, 0.2)), "{hz:?}");
+    let too_deep = BoxSpec { core: [8, 0, 0], ..graded(BoxCells::Hex) };
+    assert!(matches!(too_deep.raw(), Err(MeshError::Input(_))));
 }
 
 #[test]

@@ -6,7 +6,8 @@
 //!
 //! The comparison runs one mesh of the case's domain: by default the coarse `R0/h = 3` at the
 //! centre, 24 graded cells per axis; `BUBBLE_CELLS=<n>` and `BUBBLE_H0=<m>` choose another, with
-//! the grading that fills the domain (`BUBBLE_DOMAIN=<m>` another domain), and
+//! the grading that fills the domain (`BUBBLE_DOMAIN=<m>` another domain; `BUBBLE_CORE=<m>` keeps
+//! the cells `h0` out to about that distance from the centre before the grading starts), and
 //! `BUBBLE_CASE_MESH=1` the case folder's own mesh. `BUBBLE_OUT=<dir>` keeps the run (its
 //! `radius.csv`), `BUBBLE_PNG=<path>` the pressure picture (the case folder's is drawn by
 //! `BUBBLE_CASE_MESH=1 BUBBLE_PNG=$PWD/cases/underwater-bubble/pressure.png`), and
@@ -115,11 +116,13 @@ fn keller_miksis_tends_to_rayleigh_plesset_as_one_over_c() {
     }
 }
 
-/// The coarse mesh of the test: `(cells per axis, centre cell h0)`.
-fn test_mesh() -> (usize, f64) {
+/// The mesh of the test: `(cells per axis, centre cell h0, cells in the uniform core)`.
+fn test_mesh() -> (usize, f64, usize) {
     let cells = std::env::var("BUBBLE_CELLS").map_or(24, |s| s.parse().expect("cells per axis"));
     let h0 = std::env::var("BUBBLE_H0").map_or(R0 / 3.0, |s| s.parse().expect("h0 in m"));
-    (cells, h0)
+    let core = std::env::var("BUBBLE_CORE")
+        .map_or(0, |s| (s.parse::<f64>().expect("core size in m") / h0).round() as usize);
+    (cells, h0, core)
 }
 
 /// The case folder's domain size (its `fluid.mesh.box.hi`).
@@ -130,11 +133,14 @@ fn domain() -> f64 {
     std::env::var("BUBBLE_DOMAIN").map_or(CASE_DOMAIN, |s| s.parse().expect("domain size in m"))
 }
 
-/// The grading of `cells` cells growing from `h0` to fill [`DOMAIN`]: the root of
-/// `h0 (r^n - 1)/(r - 1) = DOMAIN`, by bisection.
-fn grading(cells: usize, h0: f64) -> f64 {
+/// The grading of `cells` cells, the first `core` of them `h0` and each after them growing, to
+/// fill [`domain`]: the root of `h0 (core + r (r^(cells - core) - 1)/(r - 1)) = domain` (with
+/// `core` at least 1), by bisection.
+fn grading(cells: usize, h0: f64, core: usize) -> f64 {
     let domain = domain();
-    let length = |r: f64| h0 * (r.powi(cells as i32) - 1.0) / (r - 1.0);
+    let core = core.max(1);
+    let graded = (cells - core) as i32;
+    let length = |r: f64| h0 * (core as f64 + r * (r.powi(graded) - 1.0) / (r - 1.0));
     assert!(length(1.0 + 1e-9) < domain, "{cells} cells of {h0} m cannot grow to fill the domain");
     let (mut lo, mut hi) = (1.0 + 1e-9, 2.0);
     for _ in 0..100 {
@@ -176,10 +182,12 @@ fn open<'a>(case: &'a Case, text: &'a str, out: &Path) -> FluidRun<'a> {
     FluidRun::open(case, text, &opts, Mode::Alone).unwrap()
 }
 
-/// The mesh overrides of `cells` graded cells per axis from a centre cell `h0` filling
-/// [`domain`].
-fn mesh_overrides(cells: usize, h0: f64) -> Vec<String> {
-    graded_box(cells, grading(cells, h0), domain())
+/// The mesh overrides of `cells` cells per axis from a centre cell `h0`, the first `core` of
+/// them equal, graded to fill [`domain`].
+fn mesh_overrides(cells: usize, h0: f64, core: usize) -> Vec<String> {
+    let mut overrides = graded_box(cells, grading(cells, h0, core), domain());
+    overrides.push(format!("fluid.mesh.box.core=[{core},{core},{core}]"));
+    overrides
 }
 
 /// The mesh overrides of a box `[0, size]³` of `cells` cells per axis growing by `r`.
@@ -325,12 +333,12 @@ fn bubble_follows_keller_miksis_to_its_first_minimum() {
     let overrides = match std::env::var("BUBBLE_CASE_MESH") {
         Ok(_) => Vec::new(),
         Err(_) => {
-            let (cells, h0) = test_mesh();
+            let (cells, h0, core) = test_mesh();
             println!(
-                "mesh: {cells} cells per axis from {h0:e} m, grading {:.5}",
-                grading(cells, h0)
+                "mesh: {cells} cells per axis from {h0:e} m, {core} in the core, grading {:.5}",
+                grading(cells, h0, core)
             );
-            mesh_overrides(cells, h0)
+            mesh_overrides(cells, h0, core)
         }
     };
     let mut overrides = overrides;

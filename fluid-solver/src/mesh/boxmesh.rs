@@ -16,21 +16,23 @@ pub enum BoxCells {
     Tet,
 }
 
-/// A box `[lo, hi]` with `cells[d]` cells along axis `d` and geometric grading: each cell along
-/// axis `d` is `grading[d]` times the previous one (1 = uniform).
+/// A box `[lo, hi]` with `cells[d]` cells along axis `d` and geometric grading: the first
+/// `core[d]` cells along axis `d` (from `lo`) are equal, and each cell after them is `grading[d]`
+/// times the previous one (1 = uniform; `core` 0 or 1 = graded from the first cell).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoxSpec {
     pub lo: [f64; 3],
     pub hi: [f64; 3],
     pub cells: [usize; 3],
     pub grading: [f64; 3],
+    pub core: [usize; 3],
     pub shape: BoxCells,
 }
 
 impl BoxSpec {
     /// A uniform box.
     pub fn uniform(lo: [f64; 3], hi: [f64; 3], cells: [usize; 3], shape: BoxCells) -> BoxSpec {
-        BoxSpec { lo, hi, cells, grading: [1.0; 3], shape }
+        BoxSpec { lo, hi, cells, grading: [1.0; 3], core: [0; 3], shape }
     }
 
     /// A one-cell-thick tube along x over `[x0, x1]` with a square section of side `width`.
@@ -42,13 +44,20 @@ impl BoxSpec {
     fn axis(&self, d: usize) -> Vec<f64> {
         let n = self.cells[d];
         let r = self.grading[d];
-        let t: Vec<f64> = if (r - 1.0).abs() < 1e-14 {
-            (0..=n).map(|k| k as f64 / n as f64).collect()
-        } else {
-            let total = (r.powi(n as i32) - 1.0) / (r - 1.0);
-            (0..=n).map(|k| (r.powi(k as i32) - 1.0) / (r - 1.0) / total).collect()
-        };
-        t.iter().map(|s| self.lo[d] + s * (self.hi[d] - self.lo[d])).collect()
+        let core = self.core[d].clamp(1, n);
+        // Cell sizes relative to the first: 1 over the core, then r, r², ...
+        let mut t = Vec::with_capacity(n + 1);
+        let (mut x, mut h) = (0.0, 1.0);
+        t.push(x);
+        for k in 0..n {
+            if k >= core {
+                h *= r;
+            }
+            x += h;
+            t.push(x);
+        }
+        let total = x;
+        t.iter().map(|s| self.lo[d] + s / total * (self.hi[d] - self.lo[d])).collect()
     }
 
     /// Builds the raw mesh.
@@ -58,6 +67,12 @@ impl BoxSpec {
                 return Err(MeshError::Input(format!(
                     "box mesh: axis {d} needs at least one cell and hi > lo (cells {}, lo {}, hi {})",
                     self.cells[d], self.lo[d], self.hi[d]
+                )));
+            }
+            if self.core[d] > self.cells[d] {
+                return Err(MeshError::Input(format!(
+                    "box mesh: axis {d} has {} cells, fewer than its core of {}",
+                    self.cells[d], self.core[d]
                 )));
             }
             if !(self.grading[d].is_finite() && self.grading[d] > 0.0) {

@@ -162,6 +162,10 @@ pub struct BoxMesh {
     /// Ratio of successive cell sizes along each axis; default uniform.
     #[serde(default = "ones")]
     pub grading: [f64; 3],
+    /// Cells along each axis, from `lo`, of equal size before the grading starts; default none
+    /// (graded from the first cell).
+    #[serde(default)]
+    pub core: [usize; 3],
     #[serde(default)]
     pub shape: BoxShape,
 }
@@ -440,6 +444,15 @@ impl FluidSection {
                             ));
                         }
                         super::require_positive("fluid.mesh.box.grading", b.grading[k])?;
+                        if b.core[k] > b.cells[k] {
+                            return Err((
+                                "fluid.mesh.box.core".into(),
+                                format!(
+                                    "expected at most the cells per axis, got core {:?}, cells {:?}",
+                                    b.core, b.cells
+                                ),
+                            ));
+                        }
                     }
                 }
                 (None, Some(_)) => {}
