@@ -93,6 +93,17 @@ pub struct Semidiscretization {
     /// The normals of the symmetry planes, along which no node on them has a momentum residual
     /// ([`crate::symmetry`]).
     pub symmetry: SymmetryPlanes,
+    /// The interface normals of a level set, if one moves the materials: the two-phase problems
+    /// of the edges between two fluids are then solved along them ([`crate::two_phase`]).
+    pub interface: Option<InterfaceNormals>,
+}
+
+/// The gradient of a level set at every node (at the start of the step), and the material on the
+/// side it points to.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterfaceNormals {
+    pub grad_phi: Vec<[f64; 3]>,
+    pub toward: MaterialId,
 }
 
 impl Semidiscretization {
@@ -163,6 +174,7 @@ impl Semidiscretization {
             gradient,
             patches,
             symmetry,
+            interface: None,
         };
         semi.set_materials(material)?;
         Ok(semi)

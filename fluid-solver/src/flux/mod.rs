@@ -18,7 +18,10 @@ mod wall;
 
 pub use hllc::hllc;
 pub use roe::{roe, ENTROPY_FIX};
-pub use wall::{two_phase_flux, two_phase_flux_with_cutoff, wall_flux, TwoPhaseFlux, WallFlux};
+pub use wall::{
+    two_phase_flux, two_phase_flux_along, two_phase_flux_with_cutoff, wall_flux, TwoPhaseFlux,
+    WallFlux,
+};
 
 use crate::eos::Eos;
 use serde::Deserialize;

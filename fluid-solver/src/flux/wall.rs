@@ -80,6 +80,25 @@ pub fn two_phase_flux_with_cutoff(
     cut: PressureCutoff,
 ) -> Result<TwoPhaseFlux, RiemannError> {
     let (nh, _) = super::unit(n);
+    two_phase_flux_along(scheme, eos_i, wi, eos_j, wj, n, nh, cut)
+}
+
+/// [`two_phase_flux_with_cutoff`] with the Riemann problem solved along the unit direction `nh`
+/// (from `i`'s fluid into `j`'s; the interface normal where it is known) instead of along `n`:
+/// the star states `W*_i = (ρ*_l, v_i + (u* - v_i·n̂) n̂, p*)` and `W*_j` likewise, each node's
+/// flux through the facet `n` between its state and its star state.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn two_phase_flux_along(
+    scheme: FluxScheme,
+    eos_i: &Eos,
+    wi: &[f64; 5],
+    eos_j: &Eos,
+    wj: &[f64; 5],
+    n: &[f64; 3],
+    nh: [f64; 3],
+    cut: PressureCutoff,
+) -> Result<TwoPhaseFlux, RiemannError> {
     let uni = wi[1] * nh[0] + wi[2] * nh[1] + wi[3] * nh[2];
     let unj = wj[1] * nh[0] + wj[2] * nh[1] + wj[3] * nh[2];
     let star = riemann::solve_with_cutoff(

@@ -4,7 +4,9 @@
 //!
 //! One step ([`LevelSet::step`]):
 //! 1. the flow and `φ` advance together by one RK2 step on the material layout of `t^n`
-//!    ([`crate::time::rk2::rk2_step_level_set`], `φ` by [`advect`]);
+//!    ([`crate::time::rk2::rk2_step_level_set`], `φ` by [`advect`]), the two-phase problems of
+//!    the edges between the fluids solved along the interface normal of `∇φ^n`
+//!    ([`crate::two_phase`]);
 //! 2. each node's material becomes the side of `φ^{n+1}` ([`LevelSet::material_of`]); a node
 //!    whose material changed takes the ghost state of the exact two-phase Riemann problem on its
 //!    edges to nodes of its new fluid ([`ghost`]), its conserved variables recomputed with the new
@@ -42,7 +44,7 @@ use crate::bc::BoundaryCondition;
 use crate::embedded::adjacency::NodeEdges;
 use crate::reconstruct::gradient::LsqGradient;
 use crate::riemann::PressureCutoff;
-use crate::semidiscretization::{FluidError, Semidiscretization};
+use crate::semidiscretization::{FluidError, InterfaceNormals, Semidiscretization};
 use crate::state::{MaterialId, State, Workspace};
 use crate::time::rk2::rk2_step_level_set;
 use crate::time::TimeStepping;
@@ -179,7 +181,9 @@ impl LevelSet {
     /// One step of the flow and the interface (module docs): RK2 of the flow and `φ` no longer
     /// than `dt_max`, the new materials and ghost states, the operator's layout, and the
     /// reinitialisation when `step_number` (the number of this step, from 1) is a multiple of
-    /// `reinit_every`. On error `state` and `semi` are unchanged.
+    /// `reinit_every`. The two-phase problems of the step are solved along the interface normals
+    /// of `∇φⁿ`, which the step gives `semi` ([`crate::two_phase`]). On error `state` is unchanged,
+    /// and so is `semi` but for those normals (of the unchanged `φ`).
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &self,
@@ -193,6 +197,21 @@ impl LevelSet {
     ) -> Result<InterfaceStep, FluidError> {
         let mut next = state.clone();
         let mut clips = 0;
+        // The interface normals of the step's two-phase problems: ∇φⁿ (a function of the state,
+        // which an error leaves unchanged).
+        for (s, p) in lws.phi.iter_mut().zip(&state.phi) {
+            s[0] = *p;
+        }
+        self.gradient.compute(&semi.mesh, &lws.phi, &mut lws.grad);
+        let toward = self.materials[1];
+        let normals = semi.interface.get_or_insert_with(|| InterfaceNormals {
+            grad_phi: vec![[0.0; 3]; state.len()],
+            toward,
+        });
+        normals.toward = toward;
+        for (g, l) in normals.grad_phi.iter_mut().zip(&lws.grad) {
+            *g = l[0];
+        }
         let dt = rk2_step_level_set(semi, self, &mut next, ws, lws, stepping, dt_max, &mut clips)?;
         let (changed, reinitialised) =
             self.after_flow(semi, &mut next, lws, &self.gradient, None, step_number)?;
