@@ -334,8 +334,7 @@ fn track(
         stamp("swept_nodes", &mut lap);
         let changes = parts.move_sides(mesh, cuts, &swept, &near);
         stamp("update_sides", &mut lap);
-        let moved =
-            Swept::new(mesh, &parts.adjacency, &changes, &parts.sides, &was_active, &parts.cuts);
+        let moved = Swept::new(mesh, &parts, &changes, &was_active);
         let filled = fill_changed(&moved, &ws.prim, |_, _| true, true)?;
         std::hint::black_box(filled);
         stamp("fill", &mut lap);

@@ -248,9 +248,7 @@ impl EmbeddedRun {
         let was_active = tracker.active.clone();
         let tracker = &mut self.tracker;
         let changes = tracker.advance(&semi.mesh, t_b, &x, &v)?;
-        let sides = &tracker.sides;
-        let swept =
-            Swept::new(&semi.mesh, &tracker.adjacency, &changes, sides, &was_active, &tracker.cuts);
+        let swept = Swept::new(&semi.mesh, tracker, &changes, &was_active);
         let changed_fluid = side_materials(&swept, semi.material());
         // The swept nodes' fluids, level set and states, from their sources before the step.
         let material = changed_fluid.as_deref().unwrap_or(semi.material());

@@ -163,14 +163,7 @@ mod tests {
                 && gained.iter().all(|&i| (mesh.coords[i as usize][0] - 0.6).abs() < 1e-12)
         );
         let filled = fill_changed(
-            &Swept::new(
-                &mesh,
-                &tracker.adjacency,
-                &changes,
-                &tracker.sides,
-                &was_active,
-                &tracker.cuts,
-            ),
+            &Swept::new(&mesh, &tracker, &changes, &was_active),
             &prim,
             |_, _| true,
             false,
@@ -186,14 +179,7 @@ mod tests {
             .collect();
         for linear in [false, true] {
             let filled = fill_changed(
-                &Swept::new(
-                    &mesh,
-                    &tracker.adjacency,
-                    &changes,
-                    &tracker.sides,
-                    &was_active,
-                    &tracker.cuts,
-                ),
+                &Swept::new(&mesh, &tracker, &changes, &was_active),
                 &prim,
                 |_, _| true,
                 linear,
@@ -218,14 +204,7 @@ mod tests {
         let s2 = wall(0.95);
         let changes = tracker.advance(&mesh, 0.4, &s2.x, &v).unwrap();
         let e = fill_changed(
-            &Swept::new(
-                &mesh,
-                &tracker.adjacency,
-                &changes,
-                &tracker.sides,
-                &was_active,
-                &tracker.cuts,
-            ),
+            &Swept::new(&mesh, &tracker, &changes, &was_active),
             &prim,
             |_, _| true,
             true,

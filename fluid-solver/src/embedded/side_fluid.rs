@@ -77,14 +77,7 @@ mod tests {
         let s1 = wall(0.61);
         let v = vec![[1.0, 0.0, 0.0]; s1.x.len()];
         let changes = tracker.advance(&mesh, 0.06, &s1.x, &v).unwrap();
-        let swept = Swept::new(
-            &mesh,
-            &tracker.adjacency,
-            &changes,
-            &tracker.sides,
-            &was_active,
-            &tracker.cuts,
-        );
+        let swept = Swept::new(&mesh, &tracker, &changes, &was_active);
         let new = side_materials(&swept, &material).expect("the swept nodes change fluid");
         let passed: Vec<usize> = (0..mesh.n_nodes()).filter(|&i| new[i] != material[i]).collect();
         assert!(!passed.is_empty());
@@ -97,14 +90,7 @@ mod tests {
         // Nothing moves: no change of fluid.
         let was_active = tracker.active.clone();
         let changes = tracker.advance(&mesh, 0.07, &s1.x, &vec![[0.0; 3]; s1.x.len()]).unwrap();
-        let swept = Swept::new(
-            &mesh,
-            &tracker.adjacency,
-            &changes,
-            &tracker.sides,
-            &was_active,
-            &tracker.cuts,
-        );
+        let swept = Swept::new(&mesh, &tracker, &changes, &was_active);
         let same = side_materials(&swept, &new);
         assert_eq!(same, None);
     }

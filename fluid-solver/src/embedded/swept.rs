@@ -7,6 +7,7 @@
 use super::adjacency::NodeEdges;
 use super::intersect::Intersections;
 use super::status::{NodeSides, NodeStatus, SideChange};
+use super::tracker::Tracker;
 use crate::mesh::Mesh;
 
 /// A step's side changes with the mesh, the new sides and cut edges and the old activity.
@@ -21,17 +22,17 @@ pub struct Swept<'a> {
 }
 
 impl<'a> Swept<'a> {
-    /// `changes` of the step, the new `sides` and cut edges `cuts` (searched, edge by edge, only
-    /// around the few changed nodes), and each node's status before the step, `was_active`.
+    /// `changes` of the step `tracker` just took (its new sides and cut edges, the cuts searched
+    /// edge by edge only around the few changed nodes), and each node's status before the step,
+    /// `was_active`.
     pub fn new(
         mesh: &'a Mesh,
-        adjacency: &'a NodeEdges,
+        tracker: &'a Tracker,
         changes: &'a [SideChange],
-        sides: &'a NodeSides,
         was_active: &'a [bool],
-        cuts: &'a Intersections,
     ) -> Swept<'a> {
         let changed = changes.iter().map(|c| c.node).collect();
+        let (adjacency, sides, cuts) = (&tracker.adjacency, &tracker.sides, &tracker.cuts);
         Swept { mesh, adjacency, changes, sides, was_active, cuts, changed }
     }
 
