@@ -229,7 +229,13 @@ fn run(overrides: &[String], t_end: f64, every: f64, out: &Path) -> BubbleRun {
     let samples = (t_end / every).round() as usize;
     for k in 1..=samples {
         let t = t_end * k as f64 / samples as f64;
-        let reached = run.advance_to(t).unwrap();
+        let reached = match run.advance_to(t) {
+            Ok(reached) => reached,
+            Err(e) => {
+                println!("run stopped: {e}");
+                break;
+            }
+        };
         radius.push((reached.t, radius_of(&run)));
         gas_mass.push(gas_mass_of(&run));
     }
@@ -239,17 +245,17 @@ fn run(overrides: &[String], t_end: f64, every: f64, out: &Path) -> BubbleRun {
         100.0 * drift,
         100.0 * (gas_mass.last().unwrap() / gas_mass[0] - 1.0)
     );
+    let mut csv = std::fs::File::create(out.join("radius.csv")).unwrap();
+    writeln!(csv, "time,radius,gas_mass").unwrap();
+    for ((t, r), m) in radius.iter().zip(&gas_mass) {
+        writeln!(csv, "{t:e},{r:e},{m:e}").unwrap();
+    }
     let steps = run.reached().step;
     let eos = run.semidiscretization().eos.clone();
     run.finish().unwrap();
     let (end, _, _) = solver::read_checkpoint(out, nodes).unwrap();
     let pressure = (0..nodes).map(|i| eos[end.material[i] as usize].cons_to_prim(&end.cons[i])[4]);
     let pressure = pressure.collect();
-    let mut csv = std::fs::File::create(out.join("radius.csv")).unwrap();
-    writeln!(csv, "time,radius,gas_mass").unwrap();
-    for ((t, r), m) in radius.iter().zip(&gas_mass) {
-        writeln!(csv, "{t:e},{r:e},{m:e}").unwrap();
-    }
     BubbleRun { radius, coords, pressure, nodes, steps, seconds: start.elapsed().as_secs_f64() }
 }
 
@@ -348,7 +354,8 @@ fn bubble_follows_keller_miksis_to_its_first_minimum() {
     let dir = tempfile::tempdir().unwrap();
     let out = std::env::var("BUBBLE_OUT").map_or_else(|_| dir.path().join("run"), PathBuf::from);
     // To 15% past the minimum (before the second maximum), the radius 150 times a cycle.
-    let t_end = 1.15 * km.t_min;
+    let t_end = std::env::var("BUBBLE_T_END")
+        .map_or(1.15 * km.t_min, |s| s.parse().expect("end time in s"));
     let result = run(&overrides, t_end, km.t_min / 150.0, &out);
     let cycle = measured_cycle(&result.radius);
     let err = [cycle.r_max / km.r_max - 1.0, cycle.t_min / km.t_min - 1.0];
