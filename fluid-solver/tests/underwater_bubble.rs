@@ -11,7 +11,7 @@
 //! `BUBBLE_CASE_MESH=1` the case folder's own mesh. `BUBBLE_OUT=<dir>` keeps the run (its
 //! `radius.csv`), `BUBBLE_PNG=<path>` the pressure picture (the case folder's is drawn by
 //! `BUBBLE_CASE_MESH=1 BUBBLE_PNG=$PWD/cases/underwater-bubble/pressure.png`), and
-//! `BUBBLE_SET="key=value;..."` adds case overrides.
+//! `BUBBLE_SET="key=value;..."` adds case overrides, `BUBBLE_T_END=<s>` another end time.
 //! The equation's own checks: Rayleigh's collapse time of an empty cavity, the Rayleigh-Plesset
 //! limit (`c = ∞`: its energy invariant, the maximum radius it fixes, the minimum back at `R0`),
 //! and Keller-Miksis tending to Rayleigh-Plesset as `1/c`.
