@@ -28,8 +28,9 @@ use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
 
-/// Nodes per parallel task of the list passes.
-const CHUNK: usize = 4096;
+/// Nodes per parallel task of the list passes (a few thousand near nodes of long lists make
+/// several tasks).
+const CHUNK: usize = 256;
 
 /// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,14 +1,17 @@
 //! The near part of the mesh ([`Near`]) from node-triangle pairs kept over several steps: a
 //! Verlet list with a skin, the classic way particle codes avoid a neighbour search every step.
 //!
-//! At a rebuild every triangle box of the hierarchy is widened by the skin `δ` and the pairs of
-//! reach boxes and widened boxes are found by the tree traversal [`Near::find`] uses. While
-//! each triangle's current (swept, padded) box stays inside its widened one, a pair whose boxes
-//! overlap now is among the kept pairs, so filtering the kept pairs by the current boxes gives
-//! exactly the pairs of a fresh traversal: [`NearSkin::find`] equals [`Near::find`] (tested),
-//! at the cost of a linear pass. A triangle that leaves its widened box, a new topology or a new
-//! hierarchy size triggers the next rebuild. Nothing here is state of the run: a restarted run
-//! rebuilds at its first step and gets the same [`Near`].
+//! The triangles are kept by *runs* of consecutive numbers, each with the box around its
+//! triangles' boxes (the longest runs up to [`MAX_RUN`] whose boxes are on average no wider than
+//! twice the skin, chosen at each rebuild). At a rebuild every run box is widened by the skin `δ` and the pairs of reach
+//! boxes and widened run boxes are found by the tree traversal [`Near::find`] uses. While each
+//! run's current box stays inside its widened one, a triangle whose box meets a reach box now
+//! lies in a run kept for that node, so filtering the kept runs by their current boxes, and the
+//! triangles of the runs that pass by theirs, gives exactly the pairs of a fresh traversal, in
+//! ascending order: [`NearSkin::find`] equals [`Near::find`] (tested), at the cost of a linear
+//! pass. A run that leaves its widened box, a new topology or a new hierarchy size triggers the
+//! next rebuild. Nothing here is state of the run: a restarted run rebuilds at its first step and
+//! gets the same [`Near`].
 
 use super::near::{group_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split};
 use crate::embedded::adjacency::NodeEdges;
@@ -19,16 +22,23 @@ use crate::mesh::Mesh;
 /// a cell per step rebuilds about every fifth step.
 pub const SKIN: f64 = 0.5;
 
+/// Most consecutive triangles kept together (module docs): surfaces numbered row by row
+/// (generated grids, most mesh files) make runs a few triangles across.
+pub const MAX_RUN: usize = 16;
+
 /// Node-triangle pairs within the skin, grouped by node (module docs).
 #[derive(Debug, Clone, Default)]
 pub struct NearSkin {
-    /// Width added on every side of every triangle box at a rebuild.
+    /// Width added on every side of every run box at a rebuild.
     skin: f64,
-    /// The widened boxes of the last rebuild.
+    /// Triangles per run.
+    run: usize,
+    /// The widened run boxes of the last rebuild, and the number of triangles then.
     lo: Vec<[f64; 3]>,
     hi: Vec<[f64; 3]>,
+    triangles: usize,
     topology_version: u64,
-    /// Kept triangles of node `i`: `kept[offsets[i]..offsets[i + 1]]`, ascending.
+    /// Kept runs of node `i`: `kept[offsets[i]..offsets[i + 1]]`, ascending.
     offsets: Vec<u32>,
     kept: Vec<u32>,
     /// The nodes with kept triangles, ascending.
@@ -44,28 +54,35 @@ impl NearSkin {
         let finite = adjacency.h_min.iter().filter(|h| h.is_finite());
         let (sum, n) = finite.fold((0.0, 0usize), |(s, n), h| (s + h, n + 1));
         let h = if n > 0 { sum / n as f64 } else { 0.0 };
-        NearSkin { skin: SKIN * h, ..NearSkin::default() }
+        NearSkin { skin: SKIN * h, run: 1, ..NearSkin::default() }
     }
 
-    /// Whether the kept pairs hold every overlapping pair of `bvh`'s current boxes.
-    fn holds(&self, bvh: &Bvh) -> bool {
+    /// Whether the kept pairs hold every overlapping pair of `bvh`'s current boxes, whose run
+    /// boxes are `runs`.
+    fn holds(&self, bvh: &Bvh, runs: &RunBoxes) -> bool {
         bvh.topology_version == self.topology_version
-            && bvh.len() == self.lo.len()
-            && (0..bvh.len()).all(|t| {
-                let (lo, hi) = bvh.triangle_box(t);
-                (0..3).all(|d| lo[d] >= self.lo[t][d] && hi[d] <= self.hi[t][d])
+            && bvh.len() == self.triangles
+            && runs.lo.iter().zip(&runs.hi).enumerate().all(|(r, (lo, hi))| {
+                (0..3).all(|d| lo[d] >= self.lo[r][d] && hi[d] <= self.hi[r][d])
             })
     }
 
-    /// Widens the current boxes of `bvh` and keeps the pairs they make with the reach boxes.
+    /// Widens the current run boxes `runs` of `bvh` and keeps the pairs they make with the reach
+    /// boxes.
     fn rebuild(&mut self, boxes: &NodeBoxes, bvh: &Bvh) {
         let s = self.skin;
-        (self.lo, self.hi) = (0..bvh.len())
-            .map(|t| {
-                let (lo, hi) = bvh.triangle_box(t);
-                (lo.map(|v| v - s), hi.map(|v| v + s))
-            })
-            .unzip();
+        self.run = 1;
+        let mut runs = RunBoxes::new(bvh, 1);
+        while self.run < MAX_RUN {
+            let longer = RunBoxes::new(bvh, 2 * self.run);
+            if longer.mean_width() > 2.0 * s {
+                break;
+            }
+            (self.run, runs) = (2 * self.run, longer);
+        }
+        self.lo = runs.lo.iter().map(|lo| lo.map(|v| v - s)).collect();
+        self.hi = runs.hi.iter().map(|hi| hi.map(|v| v + s)).collect();
+        self.triangles = bvh.len();
         self.topology_version = bvh.topology_version;
         let widened = Bvh::over_boxes(self.lo.clone(), self.hi.clone());
         let pairs = boxes.tree.overlapping_pairs(&widened);
@@ -87,21 +104,31 @@ impl NearSkin {
         bvh: &Bvh,
     ) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
-        if !self.holds(bvh) {
+        let mut runs = RunBoxes::new(bvh, self.run);
+        if !self.holds(bvh, &runs) {
             self.rebuild(boxes, bvh);
+            runs = RunBoxes::new(bvh, self.run);
         }
+        let run = self.run;
         let rho = boxes.rho;
-        let chunks: Vec<Lists> = par_node_chunks(&self.kept_nodes, |run| {
+        let n = bvh.len();
+        let chunks: Vec<Lists> = par_node_chunks(&self.kept_nodes, |nodes| {
             let mut lists = Lists::default();
-            for &i in run {
+            for &i in nodes {
                 let i_ = i as usize;
                 let start = lists.len();
                 let (lo, hi) = boxes.tree.triangle_box(i_);
                 let split = Split::new(&mesh.coords[i_], rho);
-                for &t in &self.kept[self.offsets[i_] as usize..self.offsets[i_ + 1] as usize] {
-                    let (a, b) = bvh.triangle_box(t as usize);
-                    if overlaps(&lo, &hi, &a, &b) {
-                        lists.push(t, &split, &a, &b);
+                for &r in &self.kept[self.offsets[i_] as usize..self.offsets[i_ + 1] as usize] {
+                    let r = r as usize;
+                    if !overlaps(&lo, &hi, &runs.lo[r], &runs.hi[r]) {
+                        continue;
+                    }
+                    for t in r * run..((r + 1) * run).min(n) {
+                        let (a, b) = bvh.triangle_box(t);
+                        if overlaps(&lo, &hi, &a, &b) {
+                            lists.push(t as u32, &split, &a, &b);
+                        }
                     }
                 }
                 lists.close(i, start);
@@ -119,6 +146,40 @@ impl NearSkin {
             + size_of_val(&self.offsets[..])
             + size_of_val(&self.kept[..])
             + size_of_val(&self.kept_nodes[..])
+    }
+}
+
+/// The box around the triangle boxes of each run of `run` triangles of a hierarchy.
+struct RunBoxes {
+    lo: Vec<[f64; 3]>,
+    hi: Vec<[f64; 3]>,
+}
+
+impl RunBoxes {
+    fn new(bvh: &Bvh, run: usize) -> RunBoxes {
+        let n = bvh.len();
+        let (lo, hi) = (0..n.div_ceil(run))
+            .map(|r| {
+                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for t in r * run..((r + 1) * run).min(n) {
+                    let (a, b) = bvh.triangle_box(t);
+                    for d in 0..3 {
+                        lo[d] = lo[d].min(a[d]);
+                        hi[d] = hi[d].max(b[d]);
+                    }
+                }
+                (lo, hi)
+            })
+            .unzip();
+        RunBoxes { lo, hi }
+    }
+
+    /// The mean over the runs of the widest side of the box (0 for none).
+    fn mean_width(&self) -> f64 {
+        let widths = self.lo.iter().zip(&self.hi);
+        let sum: f64 =
+            widths.map(|(lo, hi)| (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max)).sum();
+        sum / self.lo.len().max(1) as f64
     }
 }
 
@@ -157,5 +218,45 @@ mod tests {
         }
         // Each of the three jumps left the skin.
         assert_eq!(skin.rebuilds, 4);
+    }
+
+    /// A finely meshed plate (runs of several triangles) and the same plate with its triangles
+    /// numbered at random (runs without locality): the skin's near part equals a fresh traversal
+    /// at every step of a slow drift.
+    #[test]
+    fn runs_of_any_numbering_give_the_fresh_near_part() {
+        let mesh = cube_mesh(10, 0.3, 6);
+        let adj = NodeEdges::build(&mesh);
+        let boxes = NodeBoxes::build(&mesh, &adj);
+        let fine = crate::embedded::generate::plate(
+            [0.2, 0.25, 0.4],
+            [0.6, 0.0, 0.1],
+            [0.0, 0.5, 0.05],
+            [40, 30],
+        );
+        let mut shuffled = fine.elements.clone();
+        let mut state = 12345u64;
+        for k in (1..shuffled.len()).rev() {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            shuffled.swap(k, (state >> 33) as usize % (k + 1));
+        }
+        for (label, elements, run) in [("rows", &fine.elements, 4), ("shuffled", &shuffled, 1)] {
+            let rest = crate::embedded::Surface::new(elements, fine.x.clone(), 0).unwrap();
+            let mut surface = rest.clone();
+            let mut bvh = Bvh::build(&surface, 1e-4);
+            let mut skin = NearSkin::new(&adj);
+            for step in 1..=8 {
+                let shift = 0.02 * step as f64;
+                let x: Vec<[f64; 3]> =
+                    rest.x_b.iter().map(|p| [p[0] + shift, p[1], p[2] + 0.5 * shift]).collect();
+                surface.advance(0.01 * step as f64, &x, &vec![[0.0; 3]; x.len()]);
+                bvh.update(&surface);
+                let fresh = Near::find(&mesh, &adj, &boxes, &bvh);
+                assert!(!fresh.nodes.is_empty());
+                assert_eq!(skin.find(&mesh, &adj, &boxes, &bvh), fresh, "{label}, step {step}");
+            }
+            assert!(skin.run >= run, "{label}: runs of {}", skin.run);
+            assert!(skin.rebuilds > 1, "{label}: {} rebuilds", skin.rebuilds);
+        }
     }
 }
