@@ -322,7 +322,7 @@ fn initial_radius_from_the_level_set_converges_at_second_order() {
 }
 
 #[test]
-#[ignore = "not yet passing with margin: R_max -12.1%, t_min +9.0% on this mesh; -4.87%, +0.61% on a uniform core of R0/4.25 in 5 minutes; see the case README"]
+#[ignore = "not yet passing in minutes: R_max -12.1%, t_min +9.0% on this mesh; -4.87%, +0.61% on a uniform core of R0/4.25 (5 minutes); -3.62%, -0.71% on an R0/6 core with 69k nodes (15 minutes); see the case README"]
 fn bubble_follows_keller_miksis_to_its_first_minimum() {
     let km = bubble(c_water()).first_cycle(1e-8);
     let rp = bubble(f64::INFINITY).first_cycle(1e-8);
