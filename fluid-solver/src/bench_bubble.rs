@@ -1,5 +1,5 @@
 //! The level-set row of `fluid-solver bench`: `cases/underwater-bubble` (a gas sphere in water,
-//! octant of graded hexes, two materials, the level set advected and reinitialised every 10
+//! octant of a ball meshed by [`crate::mesh::octant`], two materials, the level set advected and reinitialised every 10
 //! steps, the ghost-fluid fluxes at the interface) set up by [`crate::setup::problem`] from the
 //! case file itself, resized to about `nodes` nodes; node-steps per second per core of
 //! [`crate::levelset::LevelSet::step`] (flow, `φ`, new materials and their ghost states, the layout rebuilt when a
@@ -8,6 +8,7 @@
 
 use crate::bench::median;
 use crate::levelset::LevelSetWorkspace;
+use crate::mesh::octant::OctantSpec;
 use crate::setup::{self, Mode};
 use crate::state::Workspace;
 use interface_protocol::case::Case;
@@ -47,12 +48,28 @@ pub struct BubbleRow {
     pub measurements: Vec<BubbleMeasurement>,
 }
 
-/// Runs the row on about `nodes` nodes (the case's mesh with its cells per axis changed) for
-/// `steps` steps after one warm-up step, from the initial state, with each count of `threads`.
+/// Runs the row on at least `nodes` nodes (the case's octant mesh with the fewest core cells per
+/// edge, an even count, that give them) for `steps` steps after one warm-up step, from the
+/// initial state, with each count of `threads`.
 pub fn run(nodes: usize, steps: usize, threads: &[usize]) -> anyhow::Result<BubbleRow> {
-    let n = ((nodes as f64).cbrt().round() as usize).max(3) - 1;
-    let overrides = [format!("fluid.mesh.box.cells=[{n},{n},{n}]")];
-    let case = Case::parse(CASE, Path::new("cases/underwater-bubble/case.toml"), &overrides)?;
+    let path = Path::new("cases/underwater-bubble/case.toml");
+    let case = Case::parse(CASE, path, &[])?;
+    let o = case.fluid.as_ref().and_then(|f| f.mesh.as_ref()).and_then(|m| m.octant.clone());
+    let o = o.ok_or_else(|| anyhow::anyhow!("{}: expected an octant mesh", path.display()))?;
+    let spec = |cells: usize| OctantSpec {
+        core: o.core,
+        cells,
+        fine: o.fine.unwrap_or(o.core),
+        radius: o.radius,
+        grading: o.grading,
+        coarsen: o.coarsen.clone(),
+    };
+    let mut cells = 2;
+    while spec(cells).size().0 < nodes {
+        cells += 2;
+    }
+    let overrides = [format!("fluid.mesh.octant.cells={cells}")];
+    let case = Case::parse(CASE, path, &overrides)?;
     let start = Instant::now();
     let problem = setup::problem(&case, Mode::Alone)?;
     let setup_seconds = start.elapsed().as_secs_f64();

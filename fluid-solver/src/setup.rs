@@ -14,6 +14,7 @@ use crate::initial::{Fill, InitialCondition};
 use crate::levelset::{init, LevelSet};
 use crate::memory;
 use crate::mesh::boxmesh::{BoxCells, BoxSpec};
+use crate::mesh::octant::OctantSpec;
 use crate::mesh::{gmsh, Mesh};
 use crate::probes::{self, Placed};
 use crate::reconstruct::limiter::Limiter;
@@ -77,10 +78,14 @@ pub fn section(case: &Case) -> anyhow::Result<&FluidSection> {
 pub fn mesh(case: &Case) -> anyhow::Result<Mesh> {
     let f = section(case)?;
     let m = f.mesh.as_ref().ok_or_else(|| {
-        field_error(case, "fluid.mesh", "missing: give `box = {...}` or `file = \"mesh.msh\"`")
+        field_error(
+            case,
+            "fluid.mesh",
+            "missing: give `box = {...}`, `octant = {...}` or `file = \"mesh.msh\"`",
+        )
     })?;
-    let raw = match (&m.box_mesh, &m.file) {
-        (Some(b), _) => {
+    let raw = match (&m.box_mesh, &m.octant, &m.file) {
+        (Some(b), _, _) => {
             let key = "fluid.mesh.box.cells";
             let per_hex = match b.shape {
                 BoxShape::Hex => 1.0,
@@ -115,7 +120,22 @@ pub fn mesh(case: &Case) -> anyhow::Result<Mesh> {
             .raw()
             .map_err(|e| field_error(case, "fluid.mesh.box", e))?
         }
-        (None, Some(file)) => {
+        (None, Some(o), _) => {
+            let spec = OctantSpec {
+                core: o.core,
+                cells: o.cells,
+                fine: o.fine.unwrap_or(o.core),
+                radius: o.radius,
+                grading: o.grading,
+                coarsen: o.coarsen.clone(),
+            };
+            let (nodes, cells) = spec.size();
+            let what = format!("the fluid mesh of `fluid.mesh.octant` ({nodes} nodes)");
+            memory::ensure_fits(&what, nodes as f64, cells as f64)
+                .map_err(|e| field_error(case, "fluid.mesh.octant.cells", e))?;
+            spec.raw().map_err(|e| field_error(case, "fluid.mesh.octant", e))?
+        }
+        (None, None, Some(file)) => {
             let path = case.dir().join(file);
             let raw = gmsh::read(&path).map_err(|e| field_error(case, "fluid.mesh.file", e))?;
             let what = format!("the fluid mesh of `fluid.mesh.file = {file:?}`");
@@ -123,11 +143,11 @@ pub fn mesh(case: &Case) -> anyhow::Result<Mesh> {
                 .map_err(|e| field_error(case, "fluid.mesh.file", e))?;
             raw
         }
-        (None, None) => {
+        (None, None, None) => {
             return Err(field_error(
                 case,
                 "fluid.mesh",
-                "give `box = {...}` or `file = \"mesh.msh\"`",
+                "give `box = {...}`, `octant = {...}` or `file = \"mesh.msh\"`",
             ))
         }
     };

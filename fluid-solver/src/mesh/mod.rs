@@ -1,7 +1,7 @@
 //! Grids: geometry and connectivity only, never solver state.
 //!
 //! A [`RawMesh`] (nodes, volume cells, named boundary faces) comes from the box mesher
-//! ([`boxmesh`]) or a gmsh file ([`gmsh`]); [`Mesh::build`] renumbers its nodes (reverse
+//! ([`boxmesh`]), the ball-octant mesher ([`octant`]) or a gmsh file ([`gmsh`]); [`Mesh::build`] renumbers its nodes (reverse
 //! Cuthill-McKee), builds the edge list sorted by `(i, j)` with `i < j`, and the median-dual
 //! control volumes of thesis §3.3.1 (Eq. 3.3-3.4): dual volumes `|C_i|`, edge area normals
 //! `ν_ij = ∫_{∂C_i ∩ ∂C_j} n` oriented from `i` to `j`, and per named boundary the dual boundary
@@ -21,6 +21,7 @@ mod dual;
 pub mod geometry;
 pub mod gmsh;
 pub mod locate;
+pub mod octant;
 pub mod renumber;
 
 pub use blocks::EdgeBlocks;

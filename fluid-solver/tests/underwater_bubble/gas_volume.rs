@@ -1,7 +1,8 @@
 //! The bubble's volume from its level set, two ways:
 //!
 //! - [`piecewise_linear`]: the volume where the piecewise-linear interpolant of `φ` is positive,
-//!   each hex split into six tets about its diagonal `0-6` and each tet's share exact for a
+//!   each hex split into six tets about its diagonal `0-6`, each pyramid into two about its
+//!   base's diagonal `0-2`, and each tet's share exact for a
 //!   linear `φ` ([`positive_fraction`]). The interpolant is within `O(h²)` of the signed distance
 //!   where that is smooth (at a sphere of radius `R >> h`), so the volume is too.
 //! - [`smoothed_heaviside`]: `Σ |C_i| H(φ_i/h_i)` over the nodes' dual cells with the linear ramp
@@ -48,7 +49,7 @@ fn tet_volume(x: [[f64; 3]; 4]) -> f64 {
 }
 
 /// The volume where the piecewise-linear interpolant of the nodal `phi` is positive, over the
-/// mesh's tets and hexes (each hex as [`HEX_TETS`]).
+/// mesh's tets, hexes (each as [`HEX_TETS`]) and pyramids.
 pub fn piecewise_linear(mesh: &Mesh, phi: &[f64]) -> anyhow::Result<f64> {
     positive_integral(mesh, phi, None)
 }
@@ -66,6 +67,7 @@ fn positive_integral(mesh: &Mesh, phi: &[f64], f: Option<&[f64]>) -> anyhow::Res
         let tets: &[[usize; 4]] = match cell.kind {
             CellKind::Tet => &[[0, 1, 2, 3]],
             CellKind::Hex => &HEX_TETS,
+            CellKind::Pyramid => &[[0, 1, 2, 4], [0, 2, 3, 4]],
             other => anyhow::bail!("cell {n}: a {} has no tet split here", other.name()),
         };
         let nodes = cell.nodes();

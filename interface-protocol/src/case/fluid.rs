@@ -30,9 +30,8 @@
 //! probes = [{ name = "p1", at = [0.2, 0, 0] }]
 //! lines = [{ name = "axis", from = [0, 0, 0], to = [1, 0, 0], points = 201, times = [0.1] }]
 //!
-//! [fluid.mesh]
+//! [fluid.mesh]           # see `mesh`: a box, an octant of a ball or a gmsh file
 //! box = { lo = [0, 0, 0], hi = [1, 0.04, 0.04], cells = [100, 1, 1], shape = "hex" }
-//! # or: file = "mesh.msh"  (gmsh 4.1, physical groups name the boundaries)
 //!
 //! [fluid.initial]
 //! state = [1.0, 0.0, 0.0, 0.0, 1.0]            # [ρ, u, v, w, p] everywhere ...
@@ -57,7 +56,7 @@
 //!                  # instead of the CFL steps (refused, naming this key, if one is unstable)
 //! ```
 
-use super::{PistonFluid, Region};
+use super::{FluidMesh, PistonFluid, Region};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
@@ -128,50 +127,6 @@ pub struct FluidMaterial<'a> {
     /// The case field of its EOS: `fluid.eos` or `fluid.fluids.<name>.eos`.
     pub eos_field: String,
     pub eos: &'a toml::Value,
-}
-
-/// `[fluid.mesh]`: a box mesh or a gmsh file (exactly one).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FluidMesh {
-    #[serde(default, rename = "box")]
-    pub box_mesh: Option<BoxMesh>,
-    /// A gmsh 4.1 `.msh` file, relative to the case file.
-    #[serde(default)]
-    pub file: Option<String>,
-}
-
-/// Cell shape of a box mesh.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BoxShape {
-    #[default]
-    Hex,
-    /// Each hex split into 6 tets.
-    Tet,
-}
-
-/// `fluid.mesh.box`: faces are named `xmin, xmax, ymin, ymax, zmin, zmax`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BoxMesh {
-    pub lo: [f64; 3],
-    pub hi: [f64; 3],
-    /// Cells per axis (1 across y and z makes a one-cell-thick tube).
-    pub cells: [usize; 3],
-    /// Ratio of successive cell sizes along each axis; default uniform.
-    #[serde(default = "ones")]
-    pub grading: [f64; 3],
-    /// Cells along each axis, from `lo`, of equal size before the grading starts; default none
-    /// (graded from the first cell).
-    #[serde(default)]
-    pub core: [usize; 3],
-    #[serde(default)]
-    pub shape: BoxShape,
-}
-
-fn ones() -> [f64; 3] {
-    [1.0; 3]
 }
 
 /// `[fluid.initial]`: a background state, then regions applied in order (later ones win).
@@ -419,44 +374,7 @@ impl FluidSection {
             p.validate()?;
         }
         if let Some(m) = &self.mesh {
-            match (&m.box_mesh, &m.file) {
-                (Some(_), Some(_)) | (None, None) => {
-                    return Err((
-                        "fluid.mesh".into(),
-                        "expected exactly one of `box = {...}` or `file = \"mesh.msh\"`".into(),
-                    ))
-                }
-                (Some(b), None) => {
-                    for k in 0..3 {
-                        if b.cells[k] == 0 {
-                            return Err((
-                                "fluid.mesh.box.cells".into(),
-                                "expected >= 1 cell per axis".into(),
-                            ));
-                        }
-                        if b.hi[k].partial_cmp(&b.lo[k]).is_none_or(|o| o.is_le()) {
-                            return Err((
-                                "fluid.mesh.box.hi".into(),
-                                format!(
-                                    "expected hi > lo on every axis, got lo {:?}, hi {:?}",
-                                    b.lo, b.hi
-                                ),
-                            ));
-                        }
-                        super::require_positive("fluid.mesh.box.grading", b.grading[k])?;
-                        if b.core[k] > b.cells[k] {
-                            return Err((
-                                "fluid.mesh.box.core".into(),
-                                format!(
-                                    "expected at most the cells per axis, got core {:?}, cells {:?}",
-                                    b.core, b.cells
-                                ),
-                            ));
-                        }
-                    }
-                }
-                (None, Some(_)) => {}
-            }
+            m.validate()?;
         }
         let state_ok = |field: &str, s: &[f64; 5]| -> Result<(), (String, String)> {
             if s.iter().any(|v| !v.is_finite()) || s[0] <= 0.0 {
