@@ -56,14 +56,7 @@ pub fn run(nodes: usize, steps: usize, threads: &[usize]) -> anyhow::Result<Bubb
     let case = Case::parse(CASE, path, &[])?;
     let o = case.fluid.as_ref().and_then(|f| f.mesh.as_ref()).and_then(|m| m.octant.clone());
     let o = o.ok_or_else(|| anyhow::anyhow!("{}: expected an octant mesh", path.display()))?;
-    let spec = |cells: usize| OctantSpec {
-        core: o.core,
-        cells,
-        fine: o.fine.unwrap_or(o.core),
-        radius: o.radius,
-        grading: o.grading,
-        coarsen: o.coarsen.clone(),
-    };
+    let spec = |cells: usize| OctantSpec { cells, ..OctantSpec::from(&o) };
     let mut cells = 2;
     while spec(cells).size().0 < nodes {
         cells += 2;

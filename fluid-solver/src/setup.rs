@@ -121,14 +121,7 @@ pub fn mesh(case: &Case) -> anyhow::Result<Mesh> {
             .map_err(|e| field_error(case, "fluid.mesh.box", e))?
         }
         (None, Some(o), _) => {
-            let spec = OctantSpec {
-                core: o.core,
-                cells: o.cells,
-                fine: o.fine.unwrap_or(o.core),
-                radius: o.radius,
-                grading: o.grading,
-                coarsen: o.coarsen.clone(),
-            };
+            let spec = OctantSpec::from(o);
             let (nodes, cells) = spec.size();
             let what = format!("the fluid mesh of `fluid.mesh.octant` ({nodes} nodes)");
             memory::ensure_fits(&what, nodes as f64, cells as f64)

@@ -1,14 +1,15 @@
 //! Grids: geometry and connectivity only, never solver state.
 //!
 //! A [`RawMesh`] (nodes, volume cells, named boundary faces) comes from the box mesher
-//! ([`boxmesh`]), the ball-octant mesher ([`octant`]) or a gmsh file ([`gmsh`]); [`Mesh::build`] renumbers its nodes (reverse
-//! Cuthill-McKee), builds the edge list sorted by `(i, j)` with `i < j`, and the median-dual
-//! control volumes of thesis §3.3.1 (Eq. 3.3-3.4): dual volumes `|C_i|`, edge area normals
-//! `ν_ij = ∫_{∂C_i ∩ ∂C_j} n` oriented from `i` to `j`, and per named boundary the dual boundary
-//! area vector of each of its nodes (outward). Closure holds to round-off for every node:
-//! `Σ_{j} ±ν_ij + Σ_boundaries n_i = 0`. The edges are cut into the blocks of [`blocks`] for the
-//! parallel edge loops; nothing else is kept per edge or per node-edge pair (no node-to-edge
-//! lists), so a mesh costs about 470 bytes per node on tets, cells included.
+//! ([`boxmesh`]), the ball-octant mesher ([`octant`]) or a gmsh file ([`gmsh`]);
+//! [`Mesh::build`] renumbers its nodes (reverse Cuthill-McKee), builds the edge list sorted by
+//! `(i, j)` with `i < j`, and the median-dual control volumes of thesis §3.3.1 (Eq. 3.3-3.4):
+//! dual volumes `|C_i|`, edge area normals `ν_ij = ∫_{∂C_i ∩ ∂C_j} n` oriented from `i` to `j`,
+//! and per named boundary the dual boundary area vector of each of its nodes (outward). Closure
+//! holds to round-off for every node: `Σ_{j} ±ν_ij + Σ_boundaries n_i = 0`. The edges are cut
+//! into the blocks of [`blocks`] for the parallel edge loops; nothing else is kept per edge or
+//! per node-edge pair (no node-to-edge lists), so a mesh costs about 470 bytes per node on tets,
+//! cells included.
 //!
 //! MPI (DESIGN §10): a partition will carry its owned nodes first and ghost nodes after them in
 //! this same structure (`n_owned` below the node count); edges between two ghosts are dropped and

@@ -37,6 +37,20 @@ pub struct OctantSpec {
     pub coarsen: Vec<f64>,
 }
 
+impl From<&interface_protocol::case::OctantMesh> for OctantSpec {
+    /// The mesher's spec from a case's `fluid.mesh.octant` (`fine` defaulting to the core).
+    fn from(o: &interface_protocol::case::OctantMesh) -> OctantSpec {
+        OctantSpec {
+            core: o.core,
+            cells: o.cells,
+            fine: o.fine.unwrap_or(o.core),
+            radius: o.radius,
+            grading: o.grading,
+            coarsen: o.coarsen.clone(),
+        }
+    }
+}
+
 impl OctantSpec {
     /// The layers' radii along the axes, from `a` to `R`: steps of `h0` out to `fine`, then
     /// `h0 q, h0 q², ...` scaled (down, by less than one step's growth) to end on `R`.
