@@ -59,7 +59,11 @@ pub enum BvhError {
 /// Whether the boxes `[alo, ahi]` and `[blo, bhi]` overlap (touching counts).
 #[inline]
 pub fn overlaps(alo: &[f64; 3], ahi: &[f64; 3], blo: &[f64; 3], bhi: &[f64; 3]) -> bool {
-    (0..3).all(|d| alo[d] <= bhi[d] && blo[d] <= ahi[d])
+    // Non-short-circuit `&`: six comparisons and no branch.
+    let x = (alo[0] <= bhi[0]) & (blo[0] <= ahi[0]);
+    let y = (alo[1] <= bhi[1]) & (blo[1] <= ahi[1]);
+    let z = (alo[2] <= bhi[2]) & (blo[2] <= ahi[2]);
+    x & y & z
 }
 
 impl Bvh {
@@ -266,68 +270,6 @@ impl Bvh {
                 top += 2;
             }
         }
-    }
-
-    /// Every pair `[k, t]` of an item `k` of this tree and an item `t` of `queries` whose boxes
-    /// overlap, each pair once, by a traversal of both trees at once (pairs of nodes whose boxes
-    /// overlap, down to pairs of leaves, whose items are tested box against box), in parallel
-    /// over the subtrees of `queries` below its first levels. The order is fixed by the trees.
-    pub fn overlapping_pairs(&self, queries: &Bvh) -> Vec<[u32; 2]> {
-        use rayon::prelude::*;
-        if self.is_empty() || queries.is_empty() {
-            return Vec::new();
-        }
-        // Subtrees of `queries`: the levels below the root, split until there are enough.
-        let mut roots = vec![0u32];
-        while roots.len() < 64 {
-            let next: Vec<u32> = roots
-                .iter()
-                .flat_map(|&r| match queries.nodes[r as usize] {
-                    Node { count: 0, first, .. } => [Some(first), Some(first + 1)],
-                    _ => [Some(r), None],
-                })
-                .flatten()
-                .collect();
-            if next.len() == roots.len() {
-                break;
-            }
-            roots = next;
-        }
-        let extent = |n: &Node| (0..3).map(|d| n.hi[d] - n.lo[d]).sum::<f64>();
-        roots
-            .par_iter()
-            .flat_map_iter(|&q| {
-                let mut found = Vec::new();
-                let mut stack = vec![(q, 0u32)];
-                while let Some((a, b)) = stack.pop() {
-                    let (na, nb) = (&queries.nodes[a as usize], &self.nodes[b as usize]);
-                    if !overlaps(&na.lo, &na.hi, &nb.lo, &nb.hi) {
-                        continue;
-                    }
-                    match (na.count > 0, nb.count > 0) {
-                        (true, true) => {
-                            let items = &queries.order[na.first as usize..][..na.count as usize];
-                            for &k in &self.order[nb.first as usize..][..nb.count as usize] {
-                                let (lo, hi) = (&self.tri_lo[k as usize], &self.tri_hi[k as usize]);
-                                for &t in items {
-                                    let t_ = t as usize;
-                                    if overlaps(lo, hi, &queries.tri_lo[t_], &queries.tri_hi[t_]) {
-                                        found.push([k, t]);
-                                    }
-                                }
-                            }
-                        }
-                        (true, false) => stack.extend([(a, nb.first), (a, nb.first + 1)]),
-                        (false, true) => stack.extend([(na.first, b), (na.first + 1, b)]),
-                        (false, false) if extent(na) > extent(nb) => {
-                            stack.extend([(na.first, b), (na.first + 1, b)]);
-                        }
-                        (false, false) => stack.extend([(a, nb.first), (a, nb.first + 1)]),
-                    }
-                }
-                found
-            })
-            .collect()
     }
 
     /// Checks the invariants: every parent box contains its children, every leaf box contains its

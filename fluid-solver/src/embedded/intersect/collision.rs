@@ -18,8 +18,8 @@ use crate::embedded::CutEdge;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 
-/// Edges per parallel task.
-const CHUNK: usize = 512;
+/// Near nodes per parallel task.
+const CHUNK: usize = 64;
 
 /// Cut edges and occluded nodes of `mesh` against the surface at positions `at.x` (Alg. 4.2),
 /// testing every node and edge.
@@ -29,6 +29,12 @@ pub fn collision(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Inter
 
 /// [`collision()`] testing only the nodes and edges of `near` (which must hold every node and
 /// edge the hierarchy's boxes can reach: [`Near::find`]).
+///
+/// Node by node: each edge `[i, j]` (`i < j`) is tested at its node `i` against the triangles
+/// recorded for `i` (they hold every triangle whose box meets the edge's), once both its ends are
+/// near (an end that is not has a reach box, holding the edge, that meets no triangle box). A
+/// node's position and list are read once for all its edges, and the cuts come out in edge order
+/// (the edges are sorted by `(i, j)`).
 pub fn collision_near(
     mesh: &Mesh,
     adjacency: &NodeEdges,
@@ -38,39 +44,50 @@ pub fn collision_near(
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     let occluded = at.occluded(mesh, &adjacency.h_min, true, near);
     let cuts: Vec<CutEdge> = near
-        .edges
+        .nodes
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
-            chunk.iter().filter_map(|&e| edge_cut(mesh, adjacency, at, near, &occluded, e as usize))
+            let mut cuts = Vec::new();
+            for &i in chunk {
+                node_cuts(mesh, adjacency, at, near, &occluded, i as usize, &mut cuts);
+            }
+            cuts
         })
         .collect();
     Intersections::from_sorted(mesh, cuts, occluded)
 }
 
-/// The cut of edge `e`: its crossing nearest to node `i` (step 4), else its occluded end
-/// (step 4.2).
-fn edge_cut(
+/// The cuts of the edges `[i, j]` of node `i` with `j > i` near, in edge order: each edge's
+/// crossing nearest to node `i` (step 4), else its occluded end (step 4.2).
+fn node_cuts(
     mesh: &Mesh,
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
     near: &Near,
     occluded: &[bool],
-    e: usize,
-) -> Option<CutEdge> {
-    if let Some(c) = at.nearest_crossing(mesh, near, e, true) {
-        return Some(c);
-    }
-    let [i, j] = mesh.edges[e].map(|v| v as usize);
-    // Step 4.2: the occluded end is the intersection point.
-    for (end, alpha) in [(i, 0.0), (j, 1.0)] {
-        if occluded[end] {
-            let r = super::OCCLUSION * adjacency.h_min[end];
-            if let Some((t, cp)) =
-                at.nearest_point(mesh.coords[end], r, true, Some((near, end)), None)
-            {
-                return Some(at.cut(e, t, alpha, cp.bary));
+    i: usize,
+    cuts: &mut Vec<CutEdge>,
+) {
+    for (j, e) in adjacency.neighbours(mesh, i) {
+        if j < i || near.triangles_of(j).is_some_and(|l| l.is_empty()) {
+            continue;
+        }
+        let e = e as usize;
+        if let Some(c) = at.nearest_crossing(mesh, near, e, i, true) {
+            cuts.push(c);
+            continue;
+        }
+        // Step 4.2: the occluded end is the intersection point.
+        for (end, alpha) in [(i, 0.0), (j, 1.0)] {
+            if occluded[end] {
+                let r = super::OCCLUSION * adjacency.h_min[end];
+                if let Some((t, cp)) =
+                    at.nearest_point(mesh.coords[end], r, true, Some((near, end)), None)
+                {
+                    cuts.push(at.cut(e, t, alpha, cp.bary));
+                    break;
+                }
             }
         }
     }
-    None
 }

@@ -147,21 +147,23 @@ impl SurfaceAt<'_> {
     }
 
     /// The crossing of edge `e` nearest to its node `i` (smallest α, then lowest triangle), among
-    /// the triangles whose box meets the edge's box (those recorded in `near` for an end of the
-    /// edge), counting only hits where phi `>= 0` when `crack_aware`.
+    /// the triangles whose box meets the edge's box: those recorded in `near` for the edge's end
+    /// `k` (either end: each reach box holds the edge), counting only hits where phi `>= 0` when
+    /// `crack_aware`.
     fn nearest_crossing(
         &self,
         mesh: &Mesh,
         near: &Near,
         e: usize,
+        k: usize,
         crack_aware: bool,
     ) -> Option<CutEdge> {
         let [i, j] = mesh.edges[e].map(|v| v as usize);
+        debug_assert!(k == i || k == j, "node {k} is not an end of edge {e}");
         let (p, q) = (mesh.coords[i], mesh.coords[j]);
         let lo = [0, 1, 2].map(|d| p[d].min(q[d]));
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
         let mut best: Option<(f64, u32, [f64; 3])> = None;
-        let k = near.end_with_fewer(i, j);
         near.for_each_overlap(self.bvh, k, &mesh.coords[k], &lo, &hi, |t| {
             let [a, b, c] = self.corners(t);
             if let Some(h) = segment_triangle(p, q, a, b, c) {

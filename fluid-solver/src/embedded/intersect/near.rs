@@ -8,14 +8,17 @@
 //! meets no swept triangle box of the hierarchy is neither near nor occluded nor swept, and an
 //! edge none of whose ends is such a node crosses no triangle: each pass over [`Near`] gives
 //! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
-//! ([`NodeBoxes`], built once with the mesh) is queried with the leaves of the surface's tree.
+//! ([`NodeBoxes`], built once with the mesh) gives the nodes whose reach box meets the box around
+//! the whole surface, and each of those queries the surface's tree from its root
+//! ([`pairs_by_node`]): in parallel, node by node, so the pairs come out grouped by node.
 //!
-//! That traversal meets every pair of a node and a triangle whose boxes overlap, and [`Near`]
+//! Those queries meet every pair of a node and a triangle whose boxes overlap, and [`Near`]
 //! keeps them, grouped by node: each box a pass searches around node `i` (an edge of `i`, its
 //! occlusion ball, its projection box, the node itself) lies in the reach box of `i`, so the
 //! triangles recorded for `i` hold every triangle whose box meets it, and the pass tests those
-//! instead of querying the tree from its root. An edge takes the triangles of its end with fewer
-//! (none when one end is not near: its reach box, which holds the edge, meets no triangle box).
+//! instead of querying the tree from its root. An edge takes the triangles of one of its ends
+//! (Alg. 4.2 its first, Alg. 4.1 the one with fewer), and none when an end is not near: that
+//! end's reach box, which holds the edge, meets no triangle box.
 //!
 //! Each recorded pair also keeps which halves of the reach box, split at the node along each
 //! axis, the triangle box reaches ([`Split::halves`]). A query box on one side of the node along an
@@ -146,6 +149,33 @@ impl Lists {
         self.halves.push(split.halves(lo, hi));
     }
 
+    /// Adds the triangles of `candidates` whose box (`box_of`) overlaps `[lo, hi]` to the list
+    /// being written of the node split by `split`: every candidate is written and the length
+    /// advanced by the outcome of the test, so the pass does not branch on it.
+    #[inline]
+    pub fn push_overlapping(
+        &mut self,
+        candidates: impl ExactSizeIterator<Item = u32>,
+        split: &Split,
+        lo: &[f64; 3],
+        hi: &[f64; 3],
+        box_of: impl Fn(usize) -> ([f64; 3], [f64; 3]),
+    ) {
+        let start = self.triangles.len();
+        self.triangles.resize(start + candidates.len(), 0);
+        self.halves.resize(start + candidates.len(), 0);
+        let (triangles, halves) = (&mut self.triangles[start..], &mut self.halves[start..]);
+        let mut len = 0;
+        for t in candidates {
+            let (a, b) = box_of(t as usize);
+            triangles[len] = t;
+            halves[len] = split.halves(&a, &b);
+            len += usize::from(overlaps(lo, hi, &a, &b));
+        }
+        self.triangles.truncate(start + len);
+        self.halves.truncate(start + len);
+    }
+
     /// Ends the list of node `i`, begun when `start` triangles were written (an empty one is
     /// dropped).
     #[inline]
@@ -180,12 +210,8 @@ impl Near {
     /// from pairs kept over several steps.
     pub fn find(mesh: &Mesh, adjacency: &NodeEdges, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
-        let (offsets, triangles) =
-            group_by_node(mesh.n_nodes(), &boxes.tree.overlapping_pairs(bvh));
+        let (listed, offsets, triangles) = pairs_by_node(boxes, bvh);
         let rho = boxes.rho;
-        let listed: Vec<u32> = (0..mesh.n_nodes() as u32)
-            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
-            .collect();
         let chunks: Vec<Lists> = par_node_chunks(&listed, |run| {
             let mut lists = Lists::default();
             for &i in run {
@@ -306,27 +332,47 @@ pub(super) fn par_node_chunks<T: Send>(
     nodes.par_chunks(CHUNK).map(run).collect()
 }
 
-/// Pairs `[node, triangle]` (each once) grouped by node, by counting: the offsets (one per node
-/// and one more) and each node's triangles, ascending.
-pub(super) fn group_by_node(n: usize, pairs: &[[u32; 2]]) -> (Vec<u32>, Vec<u32>) {
+/// The pairs of a reach box of `boxes` and an item box of `tree` that overlap, grouped by node:
+/// the nodes with any (ascending), and per node of the mesh the offsets of its items in the
+/// second list (each node's ascending). Each reach box inside the box around the whole `tree` is
+/// queried from the tree's root, by runs of nodes in parallel: a pass over the surface's part of
+/// the mesh, with no traversal of the node hierarchy below that box and no regrouping.
+pub(super) fn pairs_by_node(boxes: &NodeBoxes, tree: &Bvh) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+    let n = boxes.len();
+    let (root_lo, root_hi) = tree.root_box();
+    let mut candidates = Vec::new();
+    if !tree.is_empty() {
+        boxes.tree.for_each_overlap(&root_lo, &root_hi, |i| candidates.push(i));
+    }
+    candidates.sort_unstable();
+    let chunks: Vec<(Vec<u32>, Vec<u32>, Vec<u32>)> = par_node_chunks(&candidates, |nodes| {
+        let (mut listed, mut counts, mut items) = (Vec::new(), Vec::new(), Vec::new());
+        for &i in nodes {
+            let start = items.len();
+            let (lo, hi) = boxes.tree.triangle_box(i as usize);
+            tree.for_each_overlap(&lo, &hi, |r| items.push(r));
+            if items.len() > start {
+                items[start..].sort_unstable();
+                listed.push(i);
+                counts.push((items.len() - start) as u32);
+            }
+        }
+        (listed, counts, items)
+    });
     let mut offsets = vec![0u32; n + 1];
-    for &[k, _] in pairs {
-        offsets[k as usize + 1] += 1;
+    let total = chunks.iter().map(|c| c.2.len()).sum();
+    let (mut nodes, mut kept) = (Vec::new(), Vec::with_capacity(total));
+    for (listed, counts, items) in chunks {
+        for (&i, &c) in listed.iter().zip(&counts) {
+            offsets[i as usize + 1] = c;
+        }
+        nodes.extend_from_slice(&listed);
+        kept.extend_from_slice(&items);
     }
     for i in 0..n {
         offsets[i + 1] += offsets[i];
     }
-    let mut next = offsets.clone();
-    let mut triangles = vec![0u32; pairs.len()];
-    for &[k, t] in pairs {
-        let slot = &mut next[k as usize];
-        triangles[*slot as usize] = t;
-        *slot += 1;
-    }
-    for i in 0..n {
-        triangles[offsets[i] as usize..offsets[i + 1] as usize].sort_unstable();
-    }
-    (offsets, triangles)
+    (nodes, offsets, kept)
 }
 
 #[cfg(test)]

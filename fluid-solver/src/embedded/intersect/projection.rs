@@ -317,10 +317,10 @@ fn cut_edges(
 
 /// The cut of edge `e`, whose ends differ.
 fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, near: &Near, e: usize) -> Option<CutEdge> {
-    if let Some(c) = at.nearest_crossing(mesh, near, e, false) {
+    let [i, j] = mesh.edges[e].map(|v| v as usize);
+    if let Some(c) = at.nearest_crossing(mesh, near, e, near.end_with_fewer(i, j), false) {
         return Some(c);
     }
-    let [i, j] = mesh.edges[e].map(|v| v as usize);
     let (p, q) = (mesh.coords[i], mesh.coords[j]);
     let d = sub(q, p);
     let l2 = dot(d, d);

@@ -3,17 +3,17 @@
 //!
 //! The triangles are kept by *runs* of consecutive numbers, each with the box around its
 //! triangles' boxes (the longest runs up to [`MAX_RUN`] whose boxes are on average no wider than
-//! twice the skin, chosen at each rebuild). At a rebuild every run box is widened by the skin `δ` and the pairs of reach
-//! boxes and widened run boxes are found by the tree traversal [`Near::find`] uses. While each
-//! run's current box stays inside its widened one, a triangle whose box meets a reach box now
-//! lies in a run kept for that node, so filtering the kept runs by their current boxes, and the
-//! triangles of the runs that pass by theirs, gives exactly the pairs of a fresh traversal, in
-//! ascending order: [`NearSkin::find`] equals [`Near::find`] (tested), at the cost of a linear
-//! pass. A run that leaves its widened box, a new topology or a new hierarchy size triggers the
-//! next rebuild. Nothing here is state of the run: a restarted run rebuilds at its first step and
+//! twice the skin, chosen at each rebuild). At a rebuild every run box is widened by the skin `δ`
+//! and the pairs of reach boxes and widened run boxes are found by the search [`Near::find`] uses
+//! ([`pairs_by_node`]). While each run's current box stays inside its widened one, a triangle
+//! whose box meets a reach box now lies in a run kept for that node, so filtering the kept runs by
+//! their current boxes, and the triangles of the runs that pass by theirs, gives exactly the pairs
+//! of a fresh search, in ascending order: [`NearSkin::find`] equals [`Near::find`] (tested), at
+//! the cost of a linear pass. A run that leaves its widened box, a new topology or a new hierarchy
+//! size triggers the next rebuild. Nothing here is state of the run: a restarted run rebuilds at its first step and
 //! gets the same [`Near`].
 
-use super::near::{group_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split};
+use super::near::{pairs_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
@@ -85,12 +85,7 @@ impl NearSkin {
         self.triangles = bvh.len();
         self.topology_version = bvh.topology_version;
         let widened = Bvh::over_boxes(self.lo.clone(), self.hi.clone());
-        let pairs = boxes.tree.overlapping_pairs(&widened);
-        (self.offsets, self.kept) = group_by_node(boxes.len(), &pairs);
-        let offsets = &self.offsets;
-        self.kept_nodes = (0..boxes.len() as u32)
-            .filter(|&i| offsets[i as usize + 1] > offsets[i as usize])
-            .collect();
+        (self.kept_nodes, self.offsets, self.kept) = pairs_by_node(boxes, &widened);
         self.rebuilds += 1;
     }
 
@@ -119,17 +114,21 @@ impl NearSkin {
                 let start = lists.len();
                 let (lo, hi) = boxes.tree.triangle_box(i_);
                 let split = Split::new(&mesh.coords[i_], rho);
-                for &r in &self.kept[self.offsets[i_] as usize..self.offsets[i_ + 1] as usize] {
+                let kept = &self.kept[self.offsets[i_] as usize..self.offsets[i_ + 1] as usize];
+                if run == 1 {
+                    // Each run is one triangle: its box is the run box.
+                    let kept = kept.iter().copied();
+                    lists.push_overlapping(kept, &split, &lo, &hi, |t| bvh.triangle_box(t));
+                    lists.close(i, start);
+                    continue;
+                }
+                for &r in kept {
                     let r = r as usize;
                     if !overlaps(&lo, &hi, &runs.lo[r], &runs.hi[r]) {
                         continue;
                     }
-                    for t in r * run..((r + 1) * run).min(n) {
-                        let (a, b) = bvh.triangle_box(t);
-                        if overlaps(&lo, &hi, &a, &b) {
-                            lists.push(t as u32, &split, &a, &b);
-                        }
-                    }
+                    let triangles = (r * run) as u32..((r + 1) * run).min(n) as u32;
+                    lists.push_overlapping(triangles, &split, &lo, &hi, |t| bvh.triangle_box(t));
                 }
                 lists.close(i, start);
             }
