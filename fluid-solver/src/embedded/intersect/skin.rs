@@ -10,8 +10,8 @@
 //! their current boxes, and the triangles of the runs that pass by theirs, gives exactly the pairs
 //! of a fresh search, in ascending order: [`NearSkin::find`] equals [`Near::find`] (tested), at
 //! the cost of a linear pass. A run that leaves its widened box, a new topology or a new hierarchy
-//! size triggers the next rebuild. Nothing here is state of the run: a restarted run rebuilds at its first step and
-//! gets the same [`Near`].
+//! size triggers the next rebuild. Nothing here is state of the run: a restarted run rebuilds at
+//! its first step and gets the same [`Near`].
 
 use super::near::{pairs_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split};
 use crate::embedded::adjacency::NodeEdges;
@@ -115,20 +115,18 @@ impl NearSkin {
                 let (lo, hi) = boxes.tree.triangle_box(i_);
                 let split = Split::new(&mesh.coords[i_], rho);
                 let kept = &self.kept[self.offsets[i_] as usize..self.offsets[i_ + 1] as usize];
+                let box_of = |t| bvh.triangle_box(t);
                 if run == 1 {
-                    // Each run is one triangle: its box is the run box.
-                    let kept = kept.iter().copied();
-                    lists.push_overlapping(kept, &split, &lo, &hi, |t| bvh.triangle_box(t));
-                    lists.close(i, start);
-                    continue;
-                }
-                for &r in kept {
-                    let r = r as usize;
-                    if !overlaps(&lo, &hi, &runs.lo[r], &runs.hi[r]) {
-                        continue;
+                    // Each run is one triangle, its box the run box.
+                    lists.push_overlapping(kept.iter().copied(), &split, &lo, &hi, box_of);
+                } else {
+                    for &r in kept {
+                        let r = r as usize;
+                        if overlaps(&lo, &hi, &runs.lo[r], &runs.hi[r]) {
+                            let triangles = (r * run) as u32..((r + 1) * run).min(n) as u32;
+                            lists.push_overlapping(triangles, &split, &lo, &hi, box_of);
+                        }
                     }
-                    let triangles = (r * run) as u32..((r + 1) * run).min(n) as u32;
-                    lists.push_overlapping(triangles, &split, &lo, &hi, |t| bvh.triangle_box(t));
                 }
                 lists.close(i, start);
             }
