@@ -9,8 +9,10 @@ use crate::mesh::Mesh;
 /// For each node, the edges and the cells that touch it, ascending.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeEdges {
-    /// Node `i`'s edges are `edges[offsets[i]..offsets[i + 1]]`.
+    /// Node `i`'s edges are `edges[offsets[i]..offsets[i + 1]]`, those it starts (`[i, j]`, `j > i`)
+    /// from `edges[owned[i]]` on (the edges are sorted by `(i, j)`, so these are the row's last).
     offsets: Vec<u32>,
+    owned: Vec<u32>,
     edges: Vec<u32>,
     /// Node `i`'s cells are `cells[cell_offsets[i]..cell_offsets[i + 1]]`.
     cell_offsets: Vec<u32>,
@@ -31,11 +33,17 @@ impl NodeEdges {
             offsets[k + 1] += offsets[k];
         }
         let mut fill = offsets.clone();
+        // A node that starts no edge has an empty tail.
+        let mut owned = offsets[1..].to_vec();
         let mut edges = vec![0u32; 2 * mesh.n_edges()];
         let mut h_min = vec![f64::INFINITY; n];
         // Edges are visited in ascending order, so each row comes out sorted.
         for (e, &[i, j]) in mesh.edges.iter().enumerate() {
             let l = norm(sub(mesh.coords[j as usize], mesh.coords[i as usize]));
+            if e == 0 || mesh.edges[e - 1][0] != i {
+                // The first edge node `i` starts: every edge it ends came before.
+                owned[i as usize] = fill[i as usize];
+            }
             for v in [i as usize, j as usize] {
                 edges[fill[v] as usize] = e as u32;
                 fill[v] += 1;
@@ -43,7 +51,7 @@ impl NodeEdges {
             }
         }
         let (cell_offsets, cells) = node_cells(mesh);
-        NodeEdges { offsets, edges, cell_offsets, cells, h_min }
+        NodeEdges { offsets, owned, edges, cell_offsets, cells, h_min }
     }
 
     /// The cells with node `i` among their corners.
@@ -56,6 +64,12 @@ impl NodeEdges {
     #[inline]
     pub fn edges_of(&self, i: usize) -> &[u32] {
         &self.edges[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// The edges node `i` starts (`[i, j]`, `j > i`), ascending: consecutive edge numbers.
+    #[inline]
+    pub fn owned_by(&self, i: usize) -> &[u32] {
+        &self.edges[self.owned[i] as usize..self.offsets[i + 1] as usize]
     }
 
     /// The neighbours of node `i`, each with the edge that joins them.
@@ -88,6 +102,7 @@ impl NodeEdges {
     /// Memory of the arrays in bytes.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of_val(&self.offsets[..])
+            + std::mem::size_of_val(&self.owned[..])
             + std::mem::size_of_val(&self.edges[..])
             + std::mem::size_of_val(&self.h_min[..])
             + std::mem::size_of_val(&self.cell_offsets[..])
@@ -141,6 +156,18 @@ mod tests {
         }
         assert!(count.iter().all(|&c| c == 2));
         assert_eq!(adj.h_min, mesh.min_edge_length());
+        // The edges each node starts, and those alone.
+        for i in 0..mesh.n_nodes() {
+            let want: Vec<u32> = adj
+                .edges_of(i)
+                .iter()
+                .copied()
+                .filter(|&e| mesh.edges[e as usize][0] as usize == i)
+                .collect();
+            assert_eq!(adj.owned_by(i), &want[..], "node {i}");
+        }
+        let owned: usize = (0..mesh.n_nodes()).map(|i| adj.owned_by(i).len()).sum();
+        assert_eq!(owned, mesh.n_edges());
     }
 
     #[test]

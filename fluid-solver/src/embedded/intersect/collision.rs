@@ -68,11 +68,12 @@ fn node_cuts(
     i: usize,
     cuts: &mut Vec<CutEdge>,
 ) {
-    for (j, e) in adjacency.neighbours(mesh, i) {
-        if j < i || near.triangles_of(j).is_some_and(|l| l.is_empty()) {
+    for &e in adjacency.owned_by(i) {
+        let e = e as usize;
+        let j = mesh.edges[e][1] as usize;
+        if near.triangles_of(j).is_some_and(|l| l.is_empty()) {
             continue;
         }
-        let e = e as usize;
         if let Some(c) = at.nearest_crossing(mesh, near, e, i, true) {
             cuts.push(c);
             continue;

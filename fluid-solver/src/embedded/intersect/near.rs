@@ -3,10 +3,11 @@
 //! to "avoid testing every edge against every triangle"; here it also avoids testing every edge).
 //!
 //! Each node's *reach box* is the box of the node and its neighbours ([`NodeEdges::node_box`]),
-//! widened by the occlusion radius `OCCLUSION * h_min(i)`. It holds every edge of the node, the
-//! node's occlusion ball and its projection box (Alg. 4.1 step 1), so a node whose reach box
-//! meets no swept triangle box of the hierarchy is neither near nor occluded nor swept, and an
-//! edge none of whose ends is such a node crosses no triangle: each pass over [`Near`] gives
+//! widened by the largest occlusion radius `ρ = max OCCLUSION * h_min`. It holds every edge of the
+//! node, the occlusion balls of the node and its neighbours, and its projection box (Alg. 4.1
+//! step 1). So a node whose reach box meets no swept triangle box of the hierarchy is neither
+//! near nor occluded nor swept, and an edge is cut (crossed, or with an occluded end) only if the
+//! reach boxes of both its ends meet a triangle box: each pass over [`Near`] gives
 //! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
 //! ([`NodeBoxes`], built once with the mesh) gives the nodes whose reach box meets the box around
 //! the whole surface, and each of those queries the surface's tree from its root
@@ -39,23 +40,23 @@ const CHUNK: usize = 256;
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeBoxes {
     pub(super) tree: Bvh,
-    /// The largest occlusion radius of a node: the halves of each reach box overlap by it.
+    /// The largest occlusion radius of a node, by which every reach box is widened (so a node's
+    /// box holds the occlusion ball of each of its neighbours, and an edge with an occluded end
+    /// has both ends near) and the halves of each reach box overlap.
     pub(super) rho: f64,
 }
 
 impl NodeBoxes {
     pub fn build(mesh: &Mesh, adjacency: &NodeEdges) -> NodeBoxes {
         let n = mesh.n_nodes();
-        let (mut lo, mut hi) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        let mut rho = 0.0f64;
-        for i in 0..n {
-            let (l, h) = adjacency.node_box(mesh, i);
-            let r = OCCLUSION * adjacency.h_min[i];
-            let r = if r.is_finite() { r } else { 0.0 };
-            rho = rho.max(r);
-            lo.push(l.map(|v| v - r));
-            hi.push(h.map(|v| v + r));
-        }
+        let radius = |h: f64| Some(OCCLUSION * h).filter(|r| r.is_finite());
+        let rho = adjacency.h_min.iter().filter_map(|&h| radius(h)).fold(0.0, f64::max);
+        let (lo, hi) = (0..n)
+            .map(|i| {
+                let (l, h) = adjacency.node_box(mesh, i);
+                (l.map(|v| v - rho), h.map(|v| v + rho))
+            })
+            .unzip();
         NodeBoxes { tree: Bvh::over_boxes(lo, hi), rho }
     }
 
@@ -493,6 +494,55 @@ mod tests {
         // A plane through mesh nodes: occluded nodes and the cuts at them.
         let mesh = cube_mesh(6, 0.0, 0);
         assert_same_as_full_passes(&mesh, &plane(-0.5, 1.5, -0.5, 1.5, 0.5), 1e-12, "on nodes");
+    }
+
+    /// Cells halving upwards, and a plane (boxes not padded) just below a node `j`, within its
+    /// occlusion radius but farther than the radius of its upper neighbour `i` (whose shortest
+    /// edge is half as long): the edge from `j` up to `i` is cut at its occluded end `j`, and the
+    /// near passes find it (every reach box is widened by the largest radius, so `i`'s reaches
+    /// the plane too).
+    #[test]
+    fn an_occluded_end_below_a_finer_neighbour_is_cut_by_the_near_pass() {
+        use crate::mesh::boxmesh::{BoxCells, BoxSpec};
+        let spec = BoxSpec {
+            lo: [0.0; 3],
+            hi: [1.0, 1.0, 1.0],
+            cells: [2, 2, 6],
+            grading: [1.0, 1.0, 0.5],
+            core: [0; 3],
+            shape: BoxCells::Tet,
+        };
+        let mesh = Mesh::build(spec.raw().unwrap()).unwrap();
+        let adj = NodeEdges::build(&mesh);
+        let boxes = NodeBoxes::build(&mesh, &adj);
+        // A node of the third layer, away from the box's sides, and its neighbour straight above.
+        let z: Vec<f64> = {
+            let mut z: Vec<f64> = mesh.coords.iter().map(|p| p[2]).collect();
+            z.sort_by(f64::total_cmp);
+            z.dedup();
+            z
+        };
+        let j = (0..mesh.n_nodes())
+            .find(|&k| mesh.coords[k] == [0.5, 0.5, z[2]])
+            .expect("a node at the centre of the third layer");
+        let (i, e) = adj
+            .neighbours(&mesh, j)
+            .find(|&(k, _)| mesh.coords[k] == [0.5, 0.5, z[3]])
+            .expect("the node above it");
+        assert!(adj.h_min[i] < 0.6 * adj.h_min[j], "{} {}", adj.h_min[i], adj.h_min[j]);
+        let d = 0.75 * OCCLUSION * adj.h_min[j];
+        assert!(d > OCCLUSION * adj.h_min[i]);
+        let s = plane(-0.5, 1.5, -0.5, 1.5, z[2] - d);
+        let bvh = Bvh::build(&s, 0.0);
+        let near = Near::find(&mesh, &adj, &boxes, &bvh);
+        assert!(near.triangles_of(i).is_some_and(|l| !l.is_empty()), "node {i} is not near");
+        let at = SurfaceAt::at_end(&s, &bvh).unwrap();
+        let full = collision(&mesh, &adj, at);
+        assert!(full.occluded[j] && !full.occluded[i]);
+        let cut = full.find(e).expect("the edge from the occluded node is cut");
+        let alpha_j = if mesh.edges[e as usize][0] as usize == j { 0.0 } else { 1.0 };
+        assert_eq!(cut.alpha, alpha_j);
+        assert_eq!(collision_near(&mesh, &adj, at, &near), full);
     }
 
     /// A sphere moving through a perturbed mesh, by both algorithms: the tracker (which tests
