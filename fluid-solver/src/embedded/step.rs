@@ -77,8 +77,26 @@ impl PartialEq for FluxClock {
 }
 
 /// Whether edge `e` is cut, from the sorted cut list.
-fn is_cut(cut: &[u32], e: u32) -> bool {
-    cut.binary_search(&e).is_ok()
+/// The sorted union of two ascending lists (each value once; `b` may repeat values).
+fn union_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut x, mut y) = (0, 0);
+    loop {
+        let v = match (a.get(x), b.get(y)) {
+            (Some(&p), Some(&q)) => p.min(q),
+            (Some(&p), None) => p,
+            (None, Some(&q)) => q,
+            (None, None) => break,
+        };
+        while a.get(x) == Some(&v) {
+            x += 1;
+        }
+        while b.get(y) == Some(&v) {
+            y += 1;
+        }
+        out.push(v);
+    }
+    out
 }
 
 impl EmbeddedStep {
@@ -146,19 +164,22 @@ impl EmbeddedStep {
         let mesh = &semi.mesh;
         let material = semi.material();
         let cut: Vec<u32> = tracker.cuts.cuts.iter().map(|c| c.edge).collect();
-        let mut edges: Vec<u32> = self.cut.iter().chain(&cut).copied().collect();
+        let mut changed: Vec<u32> = Vec::new();
         for (i, (now, before)) in tracker.active.iter().zip(&self.active).enumerate() {
             if now != before {
-                edges.extend_from_slice(tracker.adjacency.edges_of(i));
+                changed.extend_from_slice(tracker.adjacency.edges_of(i));
             }
         }
-        edges.sort_unstable();
-        edges.dedup();
+        changed.sort_unstable();
+        // The cut edges before and now are each sorted: two merges.
+        let edges = union_sorted(&union_sorted(&self.cut, &cut), &changed);
         let mut flipped = Vec::new();
         let (mut frozen_now, mut dead_now) = (Vec::new(), Vec::new());
+        let mut cut_now = cut.iter().peekable();
         for &e in &edges {
-            let kind =
-                EdgeKind::of(mesh.edges[e as usize], is_cut(&cut, e), &tracker.active, material);
+            while cut_now.next_if(|&&c| c < e).is_some() {}
+            let is_cut = cut_now.peek() == Some(&&e);
+            let kind = EdgeKind::of(mesh.edges[e as usize], is_cut, &tracker.active, material);
             if kind.used != self.gradient.uses(e as usize) {
                 flipped.push(e);
             }
@@ -439,6 +460,14 @@ mod tests {
             })
             .collect();
         assert_eq!(step.special.all(), &expected[..], "{label}");
+    }
+
+    #[test]
+    fn union_of_sorted_lists_is_sorted_and_once_each() {
+        assert_eq!(union_sorted(&[1, 4, 9], &[0, 4, 4, 10]), vec![0, 1, 4, 9, 10]);
+        assert_eq!(union_sorted(&[], &[2, 2, 3]), vec![2, 3]);
+        assert_eq!(union_sorted(&[5, 7], &[]), vec![5, 7]);
+        assert!(union_sorted(&[], &[]).is_empty());
     }
 
     /// A sphere (Alg. 4.1 and 4.2) and a plane through the slip walls (Alg. 4.2, so the mirror
