@@ -9,9 +9,10 @@ use crate::mesh::Mesh;
 /// For each node, the edges and the cells that touch it, ascending.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeEdges {
-    /// Node `i`'s edges are `edges[offsets[i]..offsets[i + 1]]`, those it starts (`[i, j]`, `j > i`)
-    /// from `edges[owned[i]]` on (the edges are sorted by `(i, j)`, so these are the row's last).
+    /// Node `i`'s edges are `edges[offsets[i]..offsets[i + 1]]`.
     offsets: Vec<u32>,
+    /// Those node `i` starts (`[i, j]`, `j > i`) are `edges[owned[i]..offsets[i + 1]]`: the
+    /// edges are sorted by `(i, j)`, so they are the row's last.
     owned: Vec<u32>,
     edges: Vec<u32>,
     /// Node `i`'s cells are `cells[cell_offsets[i]..cell_offsets[i + 1]]`.

@@ -76,8 +76,7 @@ impl PartialEq for FluxClock {
     }
 }
 
-/// Whether edge `e` is cut, from the sorted cut list.
-/// The sorted union of two ascending lists (each value once; `b` may repeat values).
+/// The sorted union of two ascending lists, each value once.
 fn union_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
     let mut out = Vec::with_capacity(a.len() + b.len());
     let (mut x, mut y) = (0, 0);
