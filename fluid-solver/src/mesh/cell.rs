@@ -39,6 +39,36 @@ const PRISM_EDGES: &[[usize; 2]] =
 const PYRAMID_EDGES: &[[usize; 2]] =
     &[[0, 1], [1, 2], [2, 3], [3, 0], [0, 4], [1, 4], [2, 4], [3, 4]];
 
+/// Per face of a cell whose faces are `faces` and edges `edges`, the local edge along each side
+/// of the face (from its node `k` to node `k + 1`); `u8::MAX` past the face's sides.
+const fn face_sides(faces: &[&[usize]], edges: &[[usize; 2]]) -> [[u8; 4]; 6] {
+    let mut table = [[u8::MAX; 4]; 6];
+    let mut f = 0;
+    while f < faces.len() {
+        let face = faces[f];
+        let mut k = 0;
+        while k < face.len() {
+            let (a, b) = (face[k], face[(k + 1) % face.len()]);
+            let mut e = 0;
+            while e < edges.len() {
+                let [p, q] = edges[e];
+                if (p == a && q == b) || (p == b && q == a) {
+                    table[f][k] = e as u8;
+                }
+                e += 1;
+            }
+            k += 1;
+        }
+        f += 1;
+    }
+    table
+}
+
+static TET_SIDES: [[u8; 4]; 6] = face_sides(TET_FACES, TET_EDGES);
+static HEX_SIDES: [[u8; 4]; 6] = face_sides(HEX_FACES, HEX_EDGES);
+static PRISM_SIDES: [[u8; 4]; 6] = face_sides(PRISM_FACES, PRISM_EDGES);
+static PYRAMID_SIDES: [[u8; 4]; 6] = face_sides(PYRAMID_FACES, PYRAMID_EDGES);
+
 impl CellKind {
     /// Number of nodes.
     pub fn n_nodes(self) -> usize {
@@ -68,6 +98,18 @@ impl CellKind {
             CellKind::Prism => PRISM_EDGES,
             CellKind::Pyramid => PYRAMID_EDGES,
         }
+    }
+
+    /// The local edges along the sides of face `f` (from its node `k` to node `k + 1`), one per
+    /// node of the face.
+    pub fn face_sides(self, f: usize) -> &'static [u8] {
+        let table = match self {
+            CellKind::Tet => &TET_SIDES,
+            CellKind::Hex => &HEX_SIDES,
+            CellKind::Prism => &PRISM_SIDES,
+            CellKind::Pyramid => &PYRAMID_SIDES,
+        };
+        &table[f][..self.faces()[f].len()]
     }
 
     /// Name used in errors and output.
@@ -129,11 +171,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_edge_is_shared_by_two_faces_in_opposite_directions() {
+    fn every_edge_is_shared_by_two_faces_in_opposite_directions_and_lies_along_their_sides() {
         for kind in [CellKind::Tet, CellKind::Hex, CellKind::Prism, CellKind::Pyramid] {
             for &[a, b] in kind.edges() {
                 let (f1, f2) = edge_faces(kind, a, b);
                 assert_ne!(f1, f2, "{kind:?} edge {a}-{b}");
+            }
+            for (f, face) in kind.faces().iter().enumerate() {
+                let sides = kind.face_sides(f);
+                assert_eq!(sides.len(), face.len());
+                for (k, &e) in sides.iter().enumerate() {
+                    let [p, q] = kind.edges()[e as usize];
+                    let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                    assert!((p, q) == (a, b) || (p, q) == (b, a), "{kind:?} face {f} side {k}");
+                }
             }
             // Euler: V - E + F = 2.
             assert_eq!(kind.n_nodes() + kind.faces().len(), kind.edges().len() + 2);

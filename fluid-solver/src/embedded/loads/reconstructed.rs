@@ -33,7 +33,7 @@ use super::{distribute, or_zero, LoadView};
 use crate::embedded::riemann_fs::wall_normal_from_i;
 use crate::embedded::status::NO_SIDE;
 use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
-use crate::mesh::{Cell, CellKind};
+use crate::mesh::Cell;
 use rayon::prelude::*;
 
 /// One vertex of a reconstructed polygon: the intersection point, its load density `q` and the
@@ -108,7 +108,6 @@ pub(super) fn vertex_loads_in(
     let vertices: Vec<Vertex> =
         (0..view.cuts.len()).into_par_iter().with_min_len(1024).map(|k| vertex(view, k)).collect();
     let cells: Vec<&[(u32, u32)]> = pairs.chunk_by(|a, b| a.0 == b.0).collect();
-    let sides = FaceEdges::new();
     // The cells' contributions in parallel, handed to `sink` in cell order (as one pass would).
     let per_chunk: Vec<Vec<Contribution>> = cells
         .par_chunks(CELLS_PER_TASK)
@@ -121,7 +120,7 @@ pub(super) fn vertex_loads_in(
                 if cut_of.iter().flatten().count() < 3 {
                     continue;
                 }
-                cycles(cell, &sides, &cut_of, |cycle, walked| {
+                cycles(cell, &cut_of, |cycle, walked| {
                     polygon.clear();
                     polygon.extend(cycle.iter().map(|&k| vertices[k]));
                     orient(&mut polygon, walked);
@@ -201,58 +200,18 @@ fn cell_cuts(
     cut_of
 }
 
-/// The local edge of a `kind` cell joining local nodes `a` and `b`.
-fn local_edge(kind: CellKind, a: usize, b: usize) -> usize {
-    let edges = kind.edges();
-    edges.iter().position(|&[p, q]| (p, q) == (a, b) || (p, q) == (b, a)).expect("a face edge")
-}
-
-/// Per cell kind and face, the local edge of each side of the face (from its node `k` to node
-/// `k + 1`), looked up once instead of in every cut cell.
-struct FaceEdges([[[u8; 4]; 6]; 4]);
-
-impl FaceEdges {
-    const KINDS: [CellKind; 4] = [CellKind::Tet, CellKind::Hex, CellKind::Prism, CellKind::Pyramid];
-
-    fn new() -> FaceEdges {
-        let mut table = [[[0u8; 4]; 6]; 4];
-        for (row, kind) in table.iter_mut().zip(Self::KINDS) {
-            for (sides, face) in row.iter_mut().zip(kind.faces()) {
-                let n = face.len();
-                for (k, side) in sides.iter_mut().enumerate().take(n) {
-                    *side = local_edge(kind, face[k], face[(k + 1) % n]) as u8;
-                }
-            }
-        }
-        FaceEdges(table)
-    }
-
-    /// The local edges of the sides of face `f` of a `kind` cell (as many as the face has nodes).
-    #[inline]
-    fn of(&self, kind: CellKind, f: usize, n: usize) -> &[u8] {
-        let row = Self::KINDS.iter().position(|&k| k == kind).expect("a cell kind");
-        &self.0[row][f][..n]
-    }
-}
-
 /// Calls `visit` with each polygon of a cut cell as a cycle of cut-edge indices, and whether it
 /// comes from the face walk (`false`: the unordered points of a cell whose faces do not close; see
 /// the module docs). No allocation: a cell has at most 12 edges.
-fn cycles(
-    cell: &Cell,
-    sides: &FaceEdges,
-    cut_of: &[Option<usize>; 12],
-    mut visit: impl FnMut(&[usize], bool),
-) {
+fn cycles(cell: &Cell, cut_of: &[Option<usize>; 12], mut visit: impl FnMut(&[usize], bool)) {
     // Neighbours of each local edge along the polygon, through the faces.
     let mut next: [[usize; 2]; 12] = [[usize::MAX; 2]; 12];
     let mut degree = [0usize; 12];
     let mut closed = true;
     for (f, face) in cell.kind.faces().iter().enumerate() {
-        let n = face.len();
         let mut on_face = [0usize; 4];
         let mut m = 0;
-        for &l in sides.of(cell.kind, f, n) {
+        for &l in cell.kind.face_sides(f) {
             let l = l as usize;
             if cut_of[l].is_some() {
                 on_face[m] = l;
