@@ -350,7 +350,7 @@ fn track(
         if timed {
             for (c, v) in counts.iter_mut().zip([
                 near.nodes.len(),
-                near.edges.len(),
+                near.edges(mesh, &parts.adjacency).len(),
                 swept.len(),
                 changes.len(),
             ]) {

@@ -128,7 +128,7 @@ impl EmbeddedRun {
         (s.t_a, s.t_b) = (saved.t_a, saved.t_b);
         (s.x_a, s.v_a, s.x_b, s.v_b) = (saved.x_a, saved.v_a, saved.x_b, saved.v_b);
         tracker.bvh.update(&tracker.surface);
-        let near = Near::find(mesh, &tracker.adjacency, &tracker.node_boxes, &tracker.bvh);
+        let near = Near::find(mesh, &tracker.node_boxes, &tracker.bvh);
         let (adjacency, bvh) = (&tracker.adjacency, &tracker.bvh);
         if tracker.tracking == Tracking::Projection {
             // Alg. 4.1 keeps its inside from step to step: rebuilt by the whole-mesh passes.

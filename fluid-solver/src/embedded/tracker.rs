@@ -73,7 +73,7 @@ impl Tracker {
         let h = adjacency.h_min.iter().copied().fold(f64::INFINITY, f64::min);
         let bvh = Bvh::build(&surface, PAD * if h.is_finite() { h } else { 0.0 });
         let node_boxes = NodeBoxes::build(mesh, &adjacency);
-        let near = Near::find(mesh, &adjacency, &node_boxes, &bvh);
+        let near = Near::find(mesh, &node_boxes, &bvh);
         let (cuts, kept_inside) = match tracking {
             Tracking::Collision => {
                 (intersect(mesh, &adjacency, &surface, &bvh, tracking, &near)?, None)
@@ -126,7 +126,7 @@ impl Tracker {
     /// The part of the mesh the refitted hierarchy reaches ([`Near::find`], through the kept
     /// pairs of [`NearSkin`]).
     pub fn near(&mut self, mesh: &Mesh) -> Near {
-        self.near_skin.find(mesh, &self.adjacency, &self.node_boxes, &self.bvh)
+        self.near_skin.find(mesh, &self.node_boxes, &self.bvh)
     }
 
     /// The cut edges of the surface at `x_b` (Alg. 4.1 or 4.2), testing the nodes and edges of

@@ -126,7 +126,7 @@ mod tests {
         let mut checked = 0;
         for (s, pad) in &surfaces {
             let bvh = Bvh::build(s, *pad);
-            let near = Near::find(&mesh, &adj, &boxes, &bvh);
+            let near = Near::find(&mesh, &boxes, &bvh);
             let at = SurfaceAt::at_end(s, &bvh).unwrap();
             for &i in &near.nodes {
                 let i = i as usize;

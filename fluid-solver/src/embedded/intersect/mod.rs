@@ -80,6 +80,21 @@ impl Intersections {
     }
 }
 
+/// The crossing of an edge nearest to its first end found so far.
+#[derive(Debug, Clone, Copy)]
+struct Crossing {
+    alpha: f64,
+    triangle: u32,
+    bary: [f64; 3],
+}
+
+impl Crossing {
+    /// The cut record of edge `e` at this crossing.
+    fn cut(self, at: &SurfaceAt<'_>, e: usize) -> CutEdge {
+        at.cut(e, self.triangle, self.alpha, self.bary)
+    }
+}
+
 /// The surface at one set of nodal positions, with the hierarchy over it.
 #[derive(Clone, Copy)]
 pub struct SurfaceAt<'a> {
@@ -157,25 +172,41 @@ impl SurfaceAt<'_> {
         e: usize,
         k: usize,
         crack_aware: bool,
-    ) -> Option<CutEdge> {
+    ) -> Option<Crossing> {
         let [i, j] = mesh.edges[e].map(|v| v as usize);
         debug_assert!(k == i || k == j, "node {k} is not an end of edge {e}");
         let (p, q) = (mesh.coords[i], mesh.coords[j]);
         let lo = [0, 1, 2].map(|d| p[d].min(q[d]));
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
-        let mut best: Option<(f64, u32, [f64; 3])> = None;
+        let mut best = None;
         near.for_each_overlap(self.bvh, k, &mesh.coords[k], &lo, &hi, |t| {
-            let [a, b, c] = self.corners(t);
-            if let Some(h) = segment_triangle(p, q, a, b, c) {
-                if crack_aware && below_zero_or_nan(self.phi(t, h.bary)) {
-                    return;
-                }
-                if best.is_none_or(|(al, bt, _)| (h.alpha, t) < (al, bt)) {
-                    best = Some((h.alpha, t, h.bary));
-                }
-            }
+            self.offer_crossing(p, q, t, self.corners(t), crack_aware, &mut best);
         });
-        best.map(|(alpha, t, bary)| self.cut(e, t, alpha, bary))
+        best
+    }
+
+    /// Tests the segment `p q` against triangle `t` at `corners` and keeps the crossing in `best`
+    /// if it is nearer to `p` (smaller α, then lower triangle), counting only hits where phi
+    /// `>= 0` when `crack_aware`.
+    #[inline]
+    fn offer_crossing(
+        &self,
+        p: [f64; 3],
+        q: [f64; 3],
+        t: u32,
+        corners: [[f64; 3]; 3],
+        crack_aware: bool,
+        best: &mut Option<Crossing>,
+    ) {
+        let [a, b, c] = corners;
+        if let Some(h) = segment_triangle(p, q, a, b, c) {
+            if crack_aware && below_zero_or_nan(self.phi(t, h.bary)) {
+                return;
+            }
+            if best.is_none_or(|b| (h.alpha, t) < (b.alpha, b.triangle)) {
+                *best = Some(Crossing { alpha: h.alpha, triangle: t, bary: h.bary });
+            }
+        }
     }
 
     /// The closest point of the surface to `p` among the triangles whose box meets the box of

@@ -104,7 +104,7 @@ impl Split {
     /// The halves every box overlapping `[lo, hi]` reaches: the lower along `d` when
     /// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho`.
     #[inline]
-    fn needed(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
+    pub fn needed(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
         let mut bits = 0;
         for d in 0..3 {
             bits |= u8::from(hi[d] <= self.up[d]) << (2 * d);
@@ -114,13 +114,12 @@ impl Split {
     }
 }
 
-/// Mesh nodes and edges, each list ascending: the nodes whose reach box meets a triangle box and
-/// every edge touching one of them; with, from [`Near::find`], the triangles whose box meets each
-/// node's reach box and the halves of it each reaches.
+/// The mesh nodes whose reach box meets a triangle box, ascending (their edges: [`Near::edges`]);
+/// with, from [`Near::find`], the triangles whose box meets each node's reach box and the halves
+/// of it each reaches.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Near {
     pub nodes: Vec<u32>,
-    pub edges: Vec<u32>,
     /// The triangles of node `i` are `triangles[offsets[i]..offsets[i + 1]]` (`offsets` has one
     /// entry per mesh node and one more); empty for the full passes of [`Near::all`].
     offsets: Vec<u32>,
@@ -198,7 +197,6 @@ impl Near {
     pub fn all(mesh: &Mesh) -> Near {
         Near {
             nodes: (0..mesh.n_nodes() as u32).collect(),
-            edges: (0..mesh.n_edges() as u32).collect(),
             offsets: Vec::new(),
             triangles: Vec::new(),
             halves: Vec::new(),
@@ -206,10 +204,10 @@ impl Near {
         }
     }
 
-    /// The nodes of `boxes` whose reach boxes meet a triangle box of `bvh`, with their edges and
-    /// the triangles each reach box meets (ascending). [`super::skin::NearSkin`] gives the same
+    /// The nodes of `boxes` whose reach boxes meet a triangle box of `bvh`, with the triangles
+    /// each reach box meets (ascending). [`super::skin::NearSkin`] gives the same
     /// from pairs kept over several steps.
-    pub fn find(mesh: &Mesh, adjacency: &NodeEdges, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
+    pub fn find(mesh: &Mesh, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
         let (listed, offsets, triangles) = pairs_by_node(boxes, bvh);
         let rho = boxes.rho;
@@ -227,38 +225,23 @@ impl Near {
             }
             lists
         });
-        Near::from_lists(mesh, adjacency, rho, chunks)
+        Near::from_lists(mesh.n_nodes(), &listed, rho, chunks)
     }
 
-    /// The near part from the triangle lists of the nodes, by runs of nodes in node order (each
-    /// list ascending): the nodes with a non-empty list and their edges.
-    pub(super) fn from_lists(
-        mesh: &Mesh,
-        adjacency: &NodeEdges,
-        rho: f64,
-        chunks: Vec<Lists>,
-    ) -> Near {
-        let n = mesh.n_nodes();
-        let mut offsets = vec![0u32; n + 1];
-        let total = chunks.iter().map(Lists::len).sum();
-        let n_nodes = chunks.iter().map(|c| c.nodes.len()).sum();
-        let mut nodes = Vec::with_capacity(n_nodes);
-        let (mut triangles, mut all_halves) =
-            (Vec::with_capacity(total), Vec::with_capacity(total));
-        for c in chunks {
-            for (&i, &count) in c.nodes.iter().zip(&c.counts) {
-                offsets[i as usize + 1] = count;
-            }
-            nodes.extend_from_slice(&c.nodes);
-            triangles.extend_from_slice(&c.triangles);
-            all_halves.extend_from_slice(&c.halves);
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        // The edges of those nodes, ascending, through a bit set over the edges.
+    /// The near part from the triangle lists written by [`par_node_chunks`] over the ascending
+    /// `candidates` (each list ascending): the nodes with a non-empty list, joined in parallel.
+    pub(super) fn from_lists(n: usize, candidates: &[u32], rho: f64, chunks: Vec<Lists>) -> Near {
+        let runs: Vec<_> = chunks.iter().map(|c| (&c.nodes[..], &c.counts[..])).collect();
+        let (nodes, offsets) = join_offsets(n, candidates, &runs);
+        let triangles = concat(&chunks.iter().map(|c| &c.triangles[..]).collect::<Vec<_>>());
+        let halves = concat(&chunks.iter().map(|c| &c.halves[..]).collect::<Vec<_>>());
+        Near { nodes, offsets, triangles, halves, rho }
+    }
+
+    /// Every edge touching a node of the near part, ascending (through a bit set over the edges).
+    pub fn edges(&self, mesh: &Mesh, adjacency: &NodeEdges) -> Vec<u32> {
         let mut bits = vec![0u64; mesh.n_edges().div_ceil(64)];
-        for &i in &nodes {
+        for &i in &self.nodes {
             for &e in adjacency.edges_of(i as usize) {
                 bits[e as usize / 64] |= 1 << (e % 64);
             }
@@ -271,7 +254,7 @@ impl Near {
                 word &= word - 1;
             }
         }
-        Near { nodes, edges, offsets, triangles, halves: all_halves, rho }
+        edges
     }
 
     /// The triangles whose box meets the reach box of node `i`, if recorded ([`Near::find`]).
@@ -279,6 +262,15 @@ impl Near {
     pub fn triangles_of(&self, i: usize) -> Option<&[u32]> {
         let (a, b) = (*self.offsets.get(i)?, *self.offsets.get(i + 1)?);
         Some(&self.triangles[a as usize..b as usize])
+    }
+
+    /// The triangles recorded for node `i` at `p` with the halves of its reach box each reaches
+    /// and the split that tells the halves a query needs ([`Split::needed`]), if recorded
+    /// ([`Near::find`]).
+    #[inline]
+    pub(super) fn recorded(&self, i: usize, p: &[f64; 3]) -> Option<(&[u32], &[u8], Split)> {
+        let (a, b) = (*self.offsets.get(i)? as usize, *self.offsets.get(i + 1)? as usize);
+        Some((&self.triangles[a..b], &self.halves[a..b], Split::new(p, self.rho)))
     }
 
     /// Calls `visit` with every triangle of `bvh` whose box overlaps `[lo, hi]`, a box inside the
@@ -360,20 +352,60 @@ pub(super) fn pairs_by_node(boxes: &NodeBoxes, tree: &Bvh) -> (Vec<u32>, Vec<u32
         }
         (listed, counts, items)
     });
-    let mut offsets = vec![0u32; n + 1];
-    let total = chunks.iter().map(|c| c.2.len()).sum();
-    let (mut nodes, mut kept) = (Vec::new(), Vec::with_capacity(total));
-    for (listed, counts, items) in chunks {
-        for (&i, &c) in listed.iter().zip(&counts) {
-            offsets[i as usize + 1] = c;
-        }
-        nodes.extend_from_slice(&listed);
-        kept.extend_from_slice(&items);
-    }
-    for i in 0..n {
-        offsets[i + 1] += offsets[i];
-    }
+    let runs: Vec<_> = chunks.iter().map(|c| (&c.0[..], &c.1[..])).collect();
+    let (nodes, offsets) = join_offsets(n, &candidates, &runs);
+    let kept = concat(&chunks.iter().map(|c| &c.2[..]).collect::<Vec<_>>());
     (nodes, offsets, kept)
+}
+
+/// The per-node offsets of lists written by runs of the ascending `candidates`
+/// ([`par_node_chunks`]; run `c` listed the nodes `runs[c].0` with `runs[c].1` items each): the
+/// listed nodes, ascending, and the offsets of each mesh node's items in the joined list (`n + 1`
+/// of them), filled in parallel, each run the offsets of the nodes from its first candidate to
+/// the next run's.
+fn join_offsets(n: usize, candidates: &[u32], runs: &[(&[u32], &[u32])]) -> (Vec<u32>, Vec<u32>) {
+    use rayon::prelude::*;
+    let mut offsets = vec![0u32; n + 1];
+    let mut listed = vec![0u32; runs.iter().map(|r| r.0.len()).sum()];
+    let mut jobs = Vec::with_capacity(runs.len());
+    let (mut rest_offsets, mut rest_listed) = (&mut offsets[1..], &mut listed[..]);
+    let (mut first, mut base) = (0usize, 0u32);
+    for (c, &(nodes, counts)) in runs.iter().enumerate() {
+        let end = candidates.get((c + 1) * CHUNK).map_or(n, |&i| i as usize);
+        let (ends, rest) = std::mem::take(&mut rest_offsets).split_at_mut(end - first);
+        rest_offsets = rest;
+        let (to, rest) = std::mem::take(&mut rest_listed).split_at_mut(nodes.len());
+        rest_listed = rest;
+        jobs.push((first, base, ends, to, nodes, counts));
+        base += counts.iter().sum::<u32>();
+        first = end;
+    }
+    jobs.into_par_iter().for_each(|(first, mut end, ends, to, nodes, counts)| {
+        to.copy_from_slice(nodes);
+        let mut next = nodes.iter().zip(counts).peekable();
+        for (k, slot) in ends.iter_mut().enumerate() {
+            if let Some((_, &c)) = next.next_if(|(&i, _)| i as usize == first + k) {
+                end += c;
+            }
+            *slot = end;
+        }
+    });
+    (listed, offsets)
+}
+
+/// The slices of `parts` one after the other, copied in parallel.
+fn concat<T: Copy + Default + Send + Sync>(parts: &[&[T]]) -> Vec<T> {
+    use rayon::prelude::*;
+    let mut out = vec![T::default(); parts.iter().map(|p| p.len()).sum()];
+    let mut jobs = Vec::with_capacity(parts.len());
+    let mut rest = &mut out[..];
+    for &part in parts {
+        let (to, r) = std::mem::take(&mut rest).split_at_mut(part.len());
+        rest = r;
+        jobs.push((to, part));
+    }
+    jobs.into_par_iter().for_each(|(to, part)| to.copy_from_slice(part));
+    out
 }
 
 #[cfg(test)]
@@ -395,7 +427,7 @@ mod tests {
         let adj = NodeEdges::build(mesh);
         let boxes = NodeBoxes::build(mesh, &adj);
         let bvh = Bvh::build(s, pad);
-        let near = Near::find(mesh, &adj, &boxes, &bvh);
+        let near = Near::find(mesh, &boxes, &bvh);
         let at = SurfaceAt::at_end(s, &bvh).unwrap();
         let c42 = collision(mesh, &adj, at);
         assert_eq!(collision_near(mesh, &adj, at, &near), c42, "{label}: Alg. 4.2");
@@ -404,7 +436,7 @@ mod tests {
         assert_eq!(swept_nodes_among(mesh, s, &bvh, &near.nodes), swept, "{label}: swept");
         assert_eq!(swept_nodes_near(mesh, s, &bvh, &near), swept, "{label}: swept, recorded");
         assert!(!c42.cuts.is_empty(), "{label}: nothing cut");
-        assert!(near.edges.len() < mesh.n_edges(), "{label}: every edge is near");
+        assert!(near.edges(mesh, &adj).len() < mesh.n_edges(), "{label}: every edge is near");
         boxes.tree.validate().unwrap();
         // What `find` keeps is what the definition says, node by node.
         let want: Vec<u32> = (0..mesh.n_nodes() as u32)
@@ -421,7 +453,7 @@ mod tests {
             want.iter().flat_map(|&i| adj.edges_of(i as usize).to_vec()).collect();
         edges.sort_unstable();
         edges.dedup();
-        assert_eq!(near.edges, edges, "{label}");
+        assert_eq!(near.edges(mesh, &adj), edges, "{label}");
     }
 
     /// The scan of a node's recorded triangles, filtered by the halves, visits exactly the
@@ -436,7 +468,7 @@ mod tests {
         let mut queries = 0;
         for s in [sphere([0.52, 0.47, 0.5], 0.3, 6), flat, plane(-0.5, 1.5, -0.5, 1.5, 0.5)] {
             let bvh = Bvh::build(&s, 1e-9);
-            let near = Near::find(&mesh, &adj, &boxes, &bvh);
+            let near = Near::find(&mesh, &boxes, &bvh);
             for &i in &near.nodes {
                 let i = i as usize;
                 let p = mesh.coords[i];
@@ -534,7 +566,7 @@ mod tests {
         assert!(d > OCCLUSION * adj.h_min[i]);
         let s = plane(-0.5, 1.5, -0.5, 1.5, z[2] - d);
         let bvh = Bvh::build(&s, 0.0);
-        let near = Near::find(&mesh, &adj, &boxes, &bvh);
+        let near = Near::find(&mesh, &boxes, &bvh);
         assert!(near.triangles_of(i).is_some_and(|l| !l.is_empty()), "node {i} is not near");
         let at = SurfaceAt::at_end(&s, &bvh).unwrap();
         let full = collision(&mesh, &adj, at);

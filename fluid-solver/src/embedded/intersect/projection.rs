@@ -167,7 +167,7 @@ impl KeptInside {
         near: &Near,
     ) -> Intersections {
         let decided = self.decide_moved(mesh, adjacency, at, near);
-        if !self.update_near(mesh, near, &decided) {
+        if !self.update_near(mesh, adjacency, near, &decided) {
             self.full_fills += 1;
             self.inside = flood(mesh, adjacency, &near.nodes, decided);
             self.differ =
@@ -224,7 +224,13 @@ impl KeptInside {
 
     /// Sets the decided near nodes and checks (a) and (b) of the type's docs; on success the
     /// differing edges are the near ones.
-    fn update_near(&mut self, mesh: &Mesh, near: &Near, decided: &[Option<bool>]) -> bool {
+    fn update_near(
+        &mut self,
+        mesh: &Mesh,
+        adjacency: &NodeEdges,
+        near: &Near,
+        decided: &[Option<bool>],
+    ) -> bool {
         let mut reached = vec![false; self.n_parts];
         for (&i, d) in near.nodes.iter().zip(decided) {
             if let Some(v) = *d {
@@ -242,14 +248,15 @@ impl KeptInside {
             let [i, j] = mesh.edges[e as usize];
             differs(mesh, inside, e) && !(in_d(i) && in_d(j))
         };
+        let near_edges = near.edges(mesh, adjacency);
         if !reached.iter().all(|r| *r)
-            || near.edges.par_iter().any(breaks_a)
+            || near_edges.par_iter().any(breaks_a)
             || self.differ.par_iter().any(breaks_a)
         {
             return false;
         }
         self.differ =
-            near.edges.par_iter().copied().filter(|&e| differs(mesh, inside, e)).collect();
+            near_edges.par_iter().copied().filter(|&e| differs(mesh, inside, e)).collect();
         true
     }
 
@@ -319,7 +326,7 @@ fn cut_edges(
 fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, near: &Near, e: usize) -> Option<CutEdge> {
     let [i, j] = mesh.edges[e].map(|v| v as usize);
     if let Some(c) = at.nearest_crossing(mesh, near, e, near.end_with_fewer(i, j), false) {
-        return Some(c);
+        return Some(c.cut(&at, e));
     }
     let (p, q) = (mesh.coords[i], mesh.coords[j]);
     let d = sub(q, p);
@@ -520,7 +527,7 @@ mod tests {
         {
             let bvh = Bvh::build(&s, 1e-4);
             let at = SurfaceAt::at_end(&s, &bvh).unwrap();
-            let near = Near::find(&mesh, &adj, &boxes, &bvh);
+            let near = Near::find(&mesh, &boxes, &bvh);
             let want: Vec<Option<bool>> =
                 near.nodes.iter().map(|&i| decide_unpruned(&mesh, &adj, at, i as usize)).collect();
             assert!(want.iter().filter(|d| d.is_some()).count() > 100);

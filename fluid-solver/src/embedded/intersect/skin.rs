@@ -91,13 +91,7 @@ impl NearSkin {
 
     /// [`Near::find`] for `bvh`'s current boxes, from the kept pairs (rebuilt when they no
     /// longer hold every pair).
-    pub fn find(
-        &mut self,
-        mesh: &Mesh,
-        adjacency: &NodeEdges,
-        boxes: &NodeBoxes,
-        bvh: &Bvh,
-    ) -> Near {
+    pub fn find(&mut self, mesh: &Mesh, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
         let mut runs = RunBoxes::new(bvh, self.run);
         if !self.holds(bvh, &runs) {
@@ -132,7 +126,7 @@ impl NearSkin {
             }
             lists
         });
-        Near::from_lists(mesh, adjacency, rho, chunks)
+        Near::from_lists(mesh.n_nodes(), &self.kept_nodes, rho, chunks)
     }
 
     /// Memory in bytes.
@@ -205,9 +199,9 @@ mod tests {
                 rest.x_b.iter().map(|p| [p[0] + shift, p[1] - 0.5 * shift, p[2]]).collect();
             surface.advance(0.01 * step as f64, &x, &vec![[0.0; 3]; x.len()]);
             bvh.update(&surface);
-            let fresh = Near::find(&mesh, &adj, &boxes, &bvh);
+            let fresh = Near::find(&mesh, &boxes, &bvh);
             assert!(!fresh.nodes.is_empty());
-            assert_eq!(skin.find(&mesh, &adj, &boxes, &bvh), fresh, "step {step}");
+            assert_eq!(skin.find(&mesh, &boxes, &bvh), fresh, "step {step}");
             if step == 11 {
                 // 0.11 h moved against a skin of half the mean shortest edge: one rebuild, the first.
                 assert_eq!(skin.rebuilds, 1, "step {step}");
@@ -248,9 +242,9 @@ mod tests {
                     rest.x_b.iter().map(|p| [p[0] + shift, p[1], p[2] + 0.5 * shift]).collect();
                 surface.advance(0.01 * step as f64, &x, &vec![[0.0; 3]; x.len()]);
                 bvh.update(&surface);
-                let fresh = Near::find(&mesh, &adj, &boxes, &bvh);
+                let fresh = Near::find(&mesh, &boxes, &bvh);
                 assert!(!fresh.nodes.is_empty());
-                assert_eq!(skin.find(&mesh, &adj, &boxes, &bvh), fresh, "{label}, step {step}");
+                assert_eq!(skin.find(&mesh, &boxes, &bvh), fresh, "{label}, step {step}");
             }
             assert!(skin.run >= run, "{label}: runs of {}", skin.run);
             assert!(skin.rebuilds > 1, "{label}: {} rebuilds", skin.rebuilds);
