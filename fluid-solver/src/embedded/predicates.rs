@@ -45,7 +45,18 @@ pub fn segment_triangle(
     b: [f64; 3],
     c: [f64; 3],
 ) -> Option<EdgeHit> {
-    let sp = orient(a, b, c, p);
+    segment_triangle_from(p, q, [a, b, c], orient(a, b, c, p))
+}
+
+/// [`segment_triangle`] given `sp = orient(a, b, c, p)`, which the segments from one point `p`
+/// against one triangle share.
+#[inline]
+pub fn segment_triangle_from(
+    p: [f64; 3],
+    q: [f64; 3],
+    [a, b, c]: [[f64; 3]; 3],
+    sp: f64,
+) -> Option<EdgeHit> {
     let sq = orient(a, b, c, q);
     if (sp == 0.0 && sq == 0.0) || (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
         return None;

@@ -15,6 +15,7 @@
 use super::{Crossing, Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::overlaps;
+use crate::embedded::predicates::orient;
 use crate::embedded::CutEdge;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
@@ -130,12 +131,16 @@ fn node_cuts<const G: usize>(
             }
             let (tlo, thi) = at.bvh.triangle_box(t as usize);
             let corners = at.corners(t);
+            // The side of node `i`, shared by its edges: computed at the first that needs it.
+            let mut sp = None;
             while edges != 0 {
                 let k = edges.trailing_zeros() as usize;
                 edges &= edges - 1;
                 let (j, lo, hi) = ends[k];
                 if overlaps(&tlo, &thi, &lo, &hi) {
-                    at.offer_crossing(p, mesh.coords[j], t, corners, true, &mut best[k]);
+                    let [a, b, c] = corners;
+                    let sp = *sp.get_or_insert_with(|| orient(a, b, c, p));
+                    at.offer_crossing(p, mesh.coords[j], t, corners, sp, true, &mut best[k]);
                 }
             }
         }

@@ -22,7 +22,7 @@ pub use projection::{projection, projection_inside, projection_near, KeptInside}
 pub use skin::NearSkin;
 
 use super::bvh::Bvh;
-use super::predicates::{closest_point, segment_triangle, unit_normal, Closest};
+use super::predicates::{closest_point, orient, segment_triangle_from, unit_normal, Closest};
 use super::{CutEdge, Surface};
 use crate::mesh::Mesh;
 use closest::Nearest;
@@ -180,26 +180,30 @@ impl SurfaceAt<'_> {
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
         let mut best = None;
         near.for_each_overlap(self.bvh, k, &mesh.coords[k], &lo, &hi, |t| {
-            self.offer_crossing(p, q, t, self.corners(t), crack_aware, &mut best);
+            let corners = self.corners(t);
+            let [a, b, c] = corners;
+            let sp = orient(a, b, c, p);
+            self.offer_crossing(p, q, t, corners, sp, crack_aware, &mut best);
         });
         best
     }
 
-    /// Tests the segment `p q` against triangle `t` at `corners` and keeps the crossing in `best`
-    /// if it is nearer to `p` (smaller α, then lower triangle), counting only hits where phi
-    /// `>= 0` when `crack_aware`.
+    /// Tests the segment `p q` against triangle `t` at `corners` (`sp` the orientation of `p`
+    /// against it, [`orient`]) and keeps the crossing in `best` if it is nearer to `p` (smaller
+    /// α, then lower triangle), counting only hits where phi `>= 0` when `crack_aware`.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     fn offer_crossing(
         &self,
         p: [f64; 3],
         q: [f64; 3],
         t: u32,
         corners: [[f64; 3]; 3],
+        sp: f64,
         crack_aware: bool,
         best: &mut Option<Crossing>,
     ) {
-        let [a, b, c] = corners;
-        if let Some(h) = segment_triangle(p, q, a, b, c) {
+        if let Some(h) = segment_triangle_from(p, q, corners, sp) {
             if crack_aware && below_zero_or_nan(self.phi(t, h.bary)) {
                 return;
             }
