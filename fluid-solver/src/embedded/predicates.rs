@@ -61,12 +61,18 @@ pub fn segment_triangle_from(
     if (sp == 0.0 && sq == 0.0) || (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
         return None;
     }
-    let v = [orient(p, q, b, c), orient(p, q, c, a), orient(p, q, a, b)];
-    let pos = v.iter().any(|&x| x > 0.0);
-    let neg = v.iter().any(|&x| x < 0.0);
-    if pos && neg {
+    // The line misses the closed triangle when two of the volumes take opposite signs: the
+    // third is computed only when the first two do not.
+    let opposite = |x: f64, y: f64| (x > 0.0 && y < 0.0) || (x < 0.0 && y > 0.0);
+    let (va, vb) = (orient(p, q, b, c), orient(p, q, c, a));
+    if opposite(va, vb) {
         return None;
     }
+    let vc = orient(p, q, a, b);
+    if opposite(va, vc) || opposite(vb, vc) {
+        return None;
+    }
+    let v = [va, vb, vc];
     // Not coplanar, so the line meets the plane in one point and the volumes share one sign.
     let sum = v[0] + v[1] + v[2];
     let bary = [v[0] / sum, v[1] / sum, v[2] / sum];
