@@ -371,7 +371,7 @@ impl Semidiscretization {
         wall: Option<&Wall<'_>>,
     ) -> Result<(), FluidError> {
         let edges = self.mesh.blocks.edges(b);
-        let special = wall.map_or(&self.special, |w| &w.step.special);
+        let special = wall.map_or(&self.special, |w| w.step.special());
         let uniform = self.uniform_eos();
         if let (Some(eos), true) = (uniform, special.block(b).is_empty()) {
             self.edge_fluxes(eos, edges, prim, grad, r);

@@ -77,7 +77,7 @@ fn a_cut_edge_between_two_fluids_takes_alg_5_1_on_both_sides() {
     let mesh = &semi.mesh;
     let step = EmbeddedStep::new(&semi, &tracker, None, InterfaceTreatment::SecondOrder);
     let (mut cut_two_fluid, mut uncut_two_fluid) = (0, 0);
-    for s in step.special.all() {
+    for s in step.special().all() {
         let [i, j] = mesh.edges[s.edge as usize].map(|v| v as usize);
         let cut = tracker.cuts.find(s.edge).is_some();
         let two_fluid = material[i] != material[j];
@@ -93,7 +93,7 @@ fn a_cut_edge_between_two_fluids_takes_alg_5_1_on_both_sides() {
             (false, false) => panic!("edge {} is special but neither cut nor two-fluid", s.edge),
         }
     }
-    let n_cut = step.special.all().iter().filter(|s| s.kind == SpecialKind::Cut).count();
+    let n_cut = step.special().all().iter().filter(|s| s.kind == SpecialKind::Cut).count();
     assert_eq!(n_cut, tracker.cuts.cuts.len(), "every cut edge is listed once");
     assert_eq!(cut_two_fluid, n_cut, "the plate separates the fluids");
     assert!(n_cut > 50 && uncut_two_fluid > 50, "{n_cut} cut, {uncut_two_fluid} uncut two-fluid");

@@ -24,20 +24,20 @@ use std::time::Duration;
 /// The embedded boundary as one step's residuals read it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EmbeddedStep {
-    /// Two-material, dead, frozen and cut edges, per block.
-    pub special: SpecialEdges,
+    /// The dead, frozen and cut edges, per block.
+    ours: SpecialEdges,
+    /// Those merged with the scheme's two-material edges, when it has any.
+    merged: Option<SpecialEdges>,
     /// Least-squares gradients through the ordinary edges only.
     pub gradient: LsqGradient,
     /// The wall material of each fluid (EOS and cavitation cut-off).
     pub materials: Vec<WallMaterial>,
     /// Number of uncut edges with exactly one active end (taken as slip walls).
     pub frozen_edges: usize,
-    /// What the step was built from, for [`EmbeddedStep::update`]: the active nodes, the cut
-    /// edges, the frozen edges and the dead edges (each ascending).
+    /// What the step was built from, for [`EmbeddedStep::update`]: the active nodes and the cut
+    /// edges (ascending).
     active: Vec<bool>,
     cut: Vec<u32>,
-    frozen: Vec<u32>,
-    dead: Vec<u32>,
     /// The states of the cut-edge fluxes ([`super::riemann_fs::interface`]); the second-order
     /// form needs the scheme's gradients (a first-order scheme takes the first-order form).
     pub interface: InterfaceTreatment,
@@ -112,17 +112,12 @@ impl EmbeddedStep {
         let active = tracker.active.clone();
         let material = semi.material();
         let cut_mask = tracker.cuts.cut_mask(mesh.n_edges());
-        let (mut frozen, mut dead) = (Vec::new(), Vec::new());
+        let mut list = Vec::new();
         let mut used = vec![true; mesh.n_edges()];
         for (e, u) in used.iter_mut().enumerate() {
             let kind = EdgeKind::of(mesh.edges[e], cut_mask[e], &active, material);
             *u = kind.used;
-            if kind.frozen {
-                frozen.push(e as u32);
-            }
-            if kind.dead {
-                dead.push(e as u32);
-            }
+            list.extend(kind.special.map(|kind| SpecialEdge { edge: e as u32, kind }));
         }
         let gradient = LsqGradient::with_planes(mesh, Some(&used), semi.gradient.planes().clone());
         let materials = semi
@@ -140,16 +135,15 @@ impl EmbeddedStep {
             true => interface,
             false => InterfaceTreatment::FirstOrder,
         };
-        let special = special_edges(semi, &frozen, &dead, &cut);
+        let (ours, merged, frozen_edges) = special_edges(semi, list);
         EmbeddedStep {
-            special,
+            ours,
+            merged,
             gradient,
             materials,
-            frozen_edges: frozen.len(),
+            frozen_edges,
             active,
             cut,
-            frozen,
-            dead,
             interface,
             wall_flux_clock: FluxClock::default(),
         }
@@ -172,8 +166,7 @@ impl EmbeddedStep {
         changed.sort_unstable();
         // The cut edges before and now are each sorted: two merges.
         let edges = union_sorted(&union_sorted(&self.cut, &cut), &changed);
-        let mut flipped = Vec::new();
-        let (mut frozen_now, mut dead_now) = (Vec::new(), Vec::new());
+        let (mut flipped, mut now) = (Vec::new(), Vec::new());
         let mut cut_now = cut.iter().peekable();
         for &e in &edges {
             while cut_now.next_if(|&&c| c < e).is_some() {}
@@ -182,39 +175,12 @@ impl EmbeddedStep {
             if kind.used != self.gradient.uses(e as usize) {
                 flipped.push(e);
             }
-            if kind.frozen {
-                frozen_now.push(e);
-            }
-            if kind.dead {
-                dead_now.push(e);
-            }
+            now.extend(kind.special.map(|kind| SpecialEdge { edge: e, kind }));
         }
         self.gradient.remask(mesh, &flipped, |i| tracker.adjacency.edges_of(i));
-        // The frozen and dead edges that were not looked at stay as they were.
-        let kept = |list: &[u32], now: Vec<u32>| {
-            // Both ascending: those of `list` not in `edges` by one merge, then `now` merged in.
-            let mut looked = edges.iter().peekable();
-            let unlooked = list.iter().copied().filter(|e| {
-                while looked.next_if(|l| *l < e).is_some() {}
-                looked.peek() != Some(&e)
-            });
-            let mut kept = Vec::with_capacity(list.len() + now.len());
-            let mut now = now.into_iter().peekable();
-            for e in unlooked {
-                while let Some(n) = now.next_if(|n| *n < e) {
-                    kept.push(n);
-                }
-                kept.push(e);
-            }
-            kept.extend(now);
-            kept
-        };
-        let frozen = kept(&self.frozen, frozen_now);
-        let dead = kept(&self.dead, dead_now);
-        self.special = special_edges(semi, &frozen, &dead, &cut);
-        self.frozen_edges = frozen.len();
-        self.frozen = frozen;
-        self.dead = dead;
+        // The special edges that were not looked at stay as they were.
+        let list = replace_sorted(self.ours.all(), &edges, &now);
+        (self.ours, self.merged, self.frozen_edges) = special_edges(semi, list);
         self.cut = cut;
         self.active.copy_from_slice(&tracker.active);
     }
@@ -223,22 +189,43 @@ impl EmbeddedStep {
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of_val;
         self.gradient.memory_bytes()
-            + self.special.memory_bytes()
+            + self.ours.memory_bytes()
+            + self.merged.as_ref().map_or(0, SpecialEdges::memory_bytes)
             + size_of_val(&self.active[..])
             + size_of_val(&self.cut[..])
-            + size_of_val(&self.frozen[..])
-            + size_of_val(&self.dead[..])
     }
+
+    /// The special edges the residual reads: the scheme's two-material edges merged with the
+    /// dead, frozen and cut ones, per block.
+    pub fn special(&self) -> &SpecialEdges {
+        self.merged.as_ref().unwrap_or(&self.ours)
+    }
+}
+
+/// The entries of `old` whose edge is not in `looked`, merged with `now` (edges of `looked`):
+/// all ascending by edge.
+fn replace_sorted(old: &[SpecialEdge], looked: &[u32], now: &[SpecialEdge]) -> Vec<SpecialEdge> {
+    let mut out = Vec::with_capacity(old.len() + now.len());
+    let (mut looked, mut now) = (looked.iter().peekable(), now.iter().peekable());
+    for s in old {
+        while let Some(n) = now.next_if(|n| n.edge < s.edge) {
+            out.push(*n);
+        }
+        while looked.next_if(|&&e| e < s.edge).is_some() {}
+        if looked.peek() != Some(&&s.edge) {
+            out.push(*s);
+        }
+    }
+    out.extend(now);
+    out
 }
 
 /// What one edge is in a step.
 struct EdgeKind {
     /// In the masked gradient: uncut, both ends active and of one material.
     used: bool,
-    /// Uncut with exactly one active end.
-    frozen: bool,
-    /// Uncut with no active end.
-    dead: bool,
+    /// Cut; else frozen (exactly one active end) or dead (no active end).
+    special: Option<SpecialKind>,
 }
 
 impl EdgeKind {
@@ -246,39 +233,28 @@ impl EdgeKind {
     fn of([i, j]: [u32; 2], cut: bool, active: &[bool], material: &[u8]) -> EdgeKind {
         let (i, j) = (i as usize, j as usize);
         let (ai, aj) = (active[i], active[j]);
-        EdgeKind {
-            used: !cut && ai && aj && material[i] == material[j],
-            frozen: !cut && ai != aj,
-            dead: !cut && !ai && !aj,
-        }
+        let special = match (cut, ai, aj) {
+            (true, ..) => Some(SpecialKind::Cut),
+            (false, true, true) => None,
+            (false, false, false) => Some(SpecialKind::Dead),
+            (false, ..) => Some(SpecialKind::Frozen),
+        };
+        EdgeKind { used: !cut && ai && aj && material[i] == material[j], special }
     }
 }
 
-/// The scheme's special edges merged with the dead, the frozen and the cut edges.
+/// The dead, frozen and cut edges of `list` (ascending) per block, merged with the scheme's
+/// special edges when it has any, and the number of frozen edges.
 fn special_edges(
     semi: &Semidiscretization,
-    frozen: &[u32],
-    dead: &[u32],
-    cut: &[u32],
-) -> SpecialEdges {
-    // The three lists are disjoint: one merge of the three into one sorted list.
-    let mut lists =
-        [(dead, SpecialKind::Dead), (frozen, SpecialKind::Frozen), (cut, SpecialKind::Cut)].map(
-            |(edges, kind)| edges.iter().map(move |&edge| SpecialEdge { edge, kind }).peekable(),
-        );
-    let mut list = Vec::with_capacity(dead.len() + frozen.len() + cut.len());
-    loop {
-        let next =
-            lists.iter_mut().enumerate().filter_map(|(k, l)| l.peek().map(|s| (s.edge, k))).min();
-        let Some((_, k)) = next else { break };
-        list.extend(lists[k].next());
-    }
+    list: Vec<SpecialEdge>,
+) -> (SpecialEdges, Option<SpecialEdges>, usize) {
+    let frozen = list.iter().filter(|s| s.kind == SpecialKind::Frozen).count();
     let blocks = &semi.mesh.blocks;
     let ours = SpecialEdges::from_sorted(blocks, list);
-    match semi.special_edges() {
-        scheme if scheme.is_empty() => ours,
-        scheme => scheme.merge(&ours, blocks),
-    }
+    let scheme = semi.special_edges();
+    let merged = (!scheme.is_empty()).then(|| scheme.merge(&ours, blocks));
+    (ours, merged, frozen)
 }
 
 /// The embedded boundary at one stage time, as the residual reads it.
@@ -458,7 +434,7 @@ mod tests {
                 Some(SpecialEdge { edge: e as u32, kind })
             })
             .collect();
-        assert_eq!(step.special.all(), &expected[..], "{label}");
+        assert_eq!(step.special().all(), &expected[..], "{label}");
     }
 
     #[test]
@@ -533,7 +509,7 @@ mod tests {
                 let fresh =
                     EmbeddedStep::new(&semi, &tracker, Some(10.0), InterfaceTreatment::SecondOrder);
                 assert_bitwise(&step, &fresh, &format!("{label}, step {k}"));
-                assert!(step.special.all().iter().any(|s| s.kind == SpecialKind::Cut));
+                assert!(step.special().all().iter().any(|s| s.kind == SpecialKind::Cut));
                 assert_kinds(&semi, &tracker, &step, &format!("{label}, step {k}"));
                 let (mut g1, mut g2) =
                     (vec![[[0.0; 3]; 5]; mesh.n_nodes()], vec![[[0.0; 3]; 5]; mesh.n_nodes()]);
