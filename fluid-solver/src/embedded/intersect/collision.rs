@@ -12,18 +12,15 @@
 //!
 //! Doubly cut edges of thin bodies are found, and an open surface needs no inside.
 
+use super::crossings::GROUP;
 use super::{Crossing, Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
-use crate::embedded::bvh::overlaps;
-use crate::embedded::predicates::orient;
 use crate::embedded::CutEdge;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 
 /// Near nodes per parallel task.
 const CHUNK: usize = 64;
-/// Edges of one node scanned together (one bit each of the halves table, at most 32).
-const GROUP: usize = 16;
 
 /// Cut edges and occluded nodes of `mesh` against the surface at positions `at.x` (Alg. 4.2),
 /// testing every node and edge.
@@ -61,9 +58,10 @@ fn collision_grouped<const G: usize>(
         .nodes
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
-            let mut cuts = Vec::new();
+            let (mut cuts, mut ends) = (Vec::new(), Vec::new());
             for &i in chunk {
-                node_cuts::<G>(mesh, adjacency, at, near, &occluded, i as usize, &mut cuts);
+                let i = i as usize;
+                node_cuts::<G>(mesh, adjacency, at, near, &occluded, i, &mut ends, &mut cuts);
             }
             cuts
         })
@@ -72,12 +70,9 @@ fn collision_grouped<const G: usize>(
 }
 
 /// The cuts of the edges `[i, j]` of node `i` with `j > i` near, in edge order: each edge's
-/// crossing nearest to node `i` (step 4), else its occluded end (step 4.2).
-///
-/// With `i`'s triangles recorded, its list is read once for up to `G` edges: a table over
-/// the 64 sets of halves a triangle box can reach gives the edges whose box needs only halves of
-/// that set ([`super::near::Split::needed`]), so each triangle meets just the edges it may overlap, the same
-/// triangles [`Near::for_each_overlap`] gives each edge.
+/// crossing nearest to node `i` (step 4, [`SurfaceAt::for_each_crossing_from`] by groups of
+/// `G`), else its occluded end (step 4.2); `ends` is a buffer.
+#[allow(clippy::too_many_arguments)]
 fn node_cuts<const G: usize>(
     mesh: &Mesh,
     adjacency: &NodeEdges,
@@ -85,71 +80,19 @@ fn node_cuts<const G: usize>(
     near: &Near,
     occluded: &[bool],
     i: usize,
+    ends: &mut Vec<(usize, usize)>,
     cuts: &mut Vec<CutEdge>,
 ) {
-    let p = mesh.coords[i];
-    let far = |j: usize| near.triangles_of(j).is_some_and(|l| l.is_empty());
-    let Some((list, halves, split)) = near.recorded(i, &p) else {
-        for &e in adjacency.owned_by(i) {
-            let j = mesh.edges[e as usize][1] as usize;
-            if !far(j) {
-                let best = at.nearest_crossing(mesh, near, e as usize, i, true);
-                edge_cut(mesh, adjacency, at, near, occluded, e as usize, best, cuts);
-            }
-        }
-        return;
-    };
-    const { assert!(G > 0 && G <= 32, "one bit per edge of a group in a u32") };
-    for group in adjacency.owned_by(i).chunks(G) {
-        let mut table = [0u32; 64];
-        let mut ends = [(0usize, p, p); G];
-        for (k, &e) in group.iter().enumerate() {
-            let j = mesh.edges[e as usize][1] as usize;
-            if far(j) {
-                continue;
-            }
-            let q = mesh.coords[j];
-            let lo = [0, 1, 2].map(|d| p[d].min(q[d]));
-            let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
-            ends[k] = (j, lo, hi);
-            // Every superset of the halves the edge box needs, in increasing order.
-            let need = split.needed(&lo, &hi);
-            let mut set = need;
-            loop {
-                table[set as usize] |= 1 << k;
-                if set == 63 {
-                    break;
-                }
-                set = (set + 1) | need;
-            }
-        }
-        let mut best = [None; G];
-        for (&t, &h) in list.iter().zip(halves) {
-            let mut edges = table[h as usize];
-            if edges == 0 {
-                continue;
-            }
-            let (tlo, thi) = at.bvh.triangle_box(t as usize);
-            let corners = at.corners(t);
-            // The side of node `i`, shared by its edges: computed at the first that needs it.
-            let mut sp = None;
-            while edges != 0 {
-                let k = edges.trailing_zeros() as usize;
-                edges &= edges - 1;
-                let (j, lo, hi) = ends[k];
-                if overlaps(&tlo, &thi, &lo, &hi) {
-                    let [a, b, c] = corners;
-                    let sp = *sp.get_or_insert_with(|| orient(a, b, c, p));
-                    at.offer_crossing(p, mesh.coords[j], t, corners, sp, true, &mut best[k]);
-                }
-            }
-        }
-        for (k, &e) in group.iter().enumerate() {
-            if !far(mesh.edges[e as usize][1] as usize) {
-                edge_cut(mesh, adjacency, at, near, occluded, e as usize, best[k], cuts);
-            }
+    ends.clear();
+    for &e in adjacency.owned_by(i) {
+        let j = mesh.edges[e as usize][1] as usize;
+        if !near.triangles_of(j).is_some_and(|l| l.is_empty()) {
+            ends.push((e as usize, j));
         }
     }
+    at.for_each_crossing_from::<G>(mesh, near, i, ends, true, |e, best| {
+        edge_cut(mesh, adjacency, at, near, occluded, e, best, cuts)
+    });
 }
 
 /// The cut of edge `e` from its nearest crossing `best` (step 4), else at its occluded end

@@ -12,6 +12,7 @@
 
 mod closest;
 pub mod collision;
+mod crossings;
 pub mod near;
 pub mod projection;
 pub mod skin;
@@ -162,24 +163,21 @@ impl SurfaceAt<'_> {
     }
 
     /// The crossing of edge `e` nearest to its node `i` (smallest α, then lowest triangle), among
-    /// the triangles whose box meets the edge's box: those recorded in `near` for the edge's end
-    /// `k` (either end: each reach box holds the edge), counting only hits where phi `>= 0` when
-    /// `crack_aware`.
+    /// the triangles whose box meets the edge's box (those recorded in `near` for `i`, whose
+    /// reach box holds the edge), counting only hits where phi `>= 0` when `crack_aware`.
     fn nearest_crossing(
         &self,
         mesh: &Mesh,
         near: &Near,
         e: usize,
-        k: usize,
         crack_aware: bool,
     ) -> Option<Crossing> {
         let [i, j] = mesh.edges[e].map(|v| v as usize);
-        debug_assert!(k == i || k == j, "node {k} is not an end of edge {e}");
         let (p, q) = (mesh.coords[i], mesh.coords[j]);
         let lo = [0, 1, 2].map(|d| p[d].min(q[d]));
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
         let mut best = None;
-        near.for_each_overlap(self.bvh, k, &mesh.coords[k], &lo, &hi, |t| {
+        near.for_each_overlap(self.bvh, i, &p, &lo, &hi, |t| {
             let corners = self.corners(t);
             let [a, b, c] = corners;
             let sp = orient(a, b, c, p);

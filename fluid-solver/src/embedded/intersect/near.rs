@@ -303,16 +303,6 @@ impl Near {
             }
         }
     }
-
-    /// Of the two ends of edge `[i, j]`, the one with fewer recorded triangles (`i` when none
-    /// are recorded): both reach boxes hold the edge.
-    #[inline]
-    pub fn end_with_fewer(&self, i: usize, j: usize) -> usize {
-        match (self.triangles_of(i), self.triangles_of(j)) {
-            (Some(a), Some(b)) if b.len() < a.len() => j,
-            _ => i,
-        }
-    }
 }
 
 /// `run` over `nodes` by runs of [`CHUNK`], in parallel, the results in the order of `nodes`

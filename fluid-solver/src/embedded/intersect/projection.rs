@@ -20,6 +20,7 @@
 //! a cracked surface is not closed.
 
 use super::closest::Nearest;
+use super::crossings::GROUP;
 use super::{Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::predicates::{closest_point, unit_normal, Feature};
@@ -315,19 +316,30 @@ fn cut_edges(
     differ: &[u32],
 ) -> Intersections {
     let occluded = at.occluded(mesh, &adjacency.h_min, false, near);
+    let first = |e: u32| mesh.edges[e as usize][0];
     let cuts: Vec<CutEdge> = differ
         .par_chunks(CHUNK)
-        .flat_map_iter(|chunk| chunk.iter().filter_map(|&e| edge_cut(mesh, at, near, e as usize)))
+        .flat_map_iter(|chunk| {
+            let (mut cuts, mut ends) = (Vec::new(), Vec::new());
+            // The edges of one node together: their crossings from one pass over its list.
+            for run in chunk.chunk_by(|&a, &b| first(a) == first(b)) {
+                ends.clear();
+                ends.extend(run.iter().map(|&e| (e as usize, mesh.edges[e as usize][1] as usize)));
+                let i = first(run[0]) as usize;
+                at.for_each_crossing_from::<GROUP>(mesh, near, i, &ends, false, |e, c| {
+                    cuts.extend(c.map(|c| c.cut(&at, e)).or_else(|| nearest_to_middle(mesh, at, e)))
+                });
+            }
+            cuts
+        })
         .collect();
     Intersections::from_sorted(mesh, cuts, occluded)
 }
 
-/// The cut of edge `e`, whose ends differ.
-fn edge_cut(mesh: &Mesh, at: SurfaceAt<'_>, near: &Near, e: usize) -> Option<CutEdge> {
+/// The cut of edge `e`, whose ends differ but which crosses no triangle (by rounding): the
+/// surface point nearest to its midpoint (within one edge length), projected onto the edge.
+fn nearest_to_middle(mesh: &Mesh, at: SurfaceAt<'_>, e: usize) -> Option<CutEdge> {
     let [i, j] = mesh.edges[e].map(|v| v as usize);
-    if let Some(c) = at.nearest_crossing(mesh, near, e, near.end_with_fewer(i, j), false) {
-        return Some(c.cut(&at, e));
-    }
     let (p, q) = (mesh.coords[i], mesh.coords[j]);
     let d = sub(q, p);
     let l2 = dot(d, d);
