@@ -32,9 +32,8 @@ pub struct Bvh {
     nodes: Vec<Node>,
     /// Triangle numbers in leaf order.
     order: Vec<u32>,
-    /// Swept, padded box of each triangle.
-    tri_lo: Vec<[f64; 3]>,
-    tri_hi: Vec<[f64; 3]>,
+    /// Swept, padded box of each triangle, lower and upper corner together (one record read).
+    boxes: Vec<[[f64; 3]; 2]>,
     /// Padding added on every side of every triangle box.
     pub pad: f64,
     /// Topology the tree was built for ([`Surface::topology_version`]).
@@ -74,8 +73,7 @@ impl Bvh {
         let mut bvh = Bvh {
             nodes: Vec::new(),
             order: Vec::new(),
-            tri_lo: vec![[0.0; 3]; n],
-            tri_hi: vec![[0.0; 3]; n],
+            boxes: vec![[[0.0; 3]; 2]; n],
             pad: pad.max(0.0),
             topology_version: surface.topology_version,
         };
@@ -91,8 +89,7 @@ impl Bvh {
         let mut bvh = Bvh {
             nodes: Vec::new(),
             order: Vec::new(),
-            tri_lo: lo,
-            tri_hi: hi,
+            boxes: lo.into_iter().zip(hi).map(|(lo, hi)| [lo, hi]).collect(),
             pad: 0.0,
             topology_version: 0,
         };
@@ -102,12 +99,12 @@ impl Bvh {
 
     /// The tree structure over the item boxes: median splits, breadth first, then the node boxes.
     fn split(&mut self) {
-        let n = self.tri_lo.len();
+        let n = self.boxes.len();
         self.nodes = Vec::with_capacity(2 * n.div_ceil(LEAF_SIZE).max(1));
         self.order = (0..n as u32).collect();
         let centres: Vec<[f64; 3]> = (0..n)
             .map(|t| {
-                let (lo, hi) = (self.tri_lo[t], self.tri_hi[t]);
+                let [lo, hi] = self.boxes[t];
                 [lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]]
             })
             .collect();
@@ -154,7 +151,7 @@ impl Bvh {
     /// changed, refitted otherwise.
     pub fn update(&mut self, surface: &Surface) {
         if surface.topology_version != self.topology_version
-            || surface.triangles.len() != self.tri_lo.len()
+            || surface.triangles.len() != self.boxes.len()
         {
             *self = Bvh::build(surface, self.pad);
         } else {
@@ -176,10 +173,10 @@ impl Bvh {
         triangles: &[[u32; 3]],
         positions: &[&[[f64; 3]]],
     ) -> Result<(), BvhError> {
-        if triangles.len() != self.tri_lo.len() {
+        if triangles.len() != self.boxes.len() {
             return Err(BvhError::Topology {
                 surface: triangles.len(),
-                tree: self.tri_lo.len(),
+                tree: self.boxes.len(),
                 version: self.topology_version,
             });
         }
@@ -190,26 +187,24 @@ impl Bvh {
 
     /// Number of triangles.
     pub fn len(&self) -> usize {
-        self.tri_lo.len()
+        self.boxes.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.tri_lo.is_empty()
+        self.boxes.is_empty()
     }
 
     /// Memory in bytes of the tree and the triangle boxes.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of_val;
-        size_of_val(&self.nodes[..])
-            + size_of_val(&self.order[..])
-            + size_of_val(&self.tri_lo[..])
-            + size_of_val(&self.tri_hi[..])
+        size_of_val(&self.nodes[..]) + size_of_val(&self.order[..]) + size_of_val(&self.boxes[..])
     }
 
     /// The swept, padded box of triangle `t`.
     #[inline]
     pub fn triangle_box(&self, t: usize) -> ([f64; 3], [f64; 3]) {
-        (self.tri_lo[t], self.tri_hi[t])
+        let [lo, hi] = self.boxes[t];
+        (lo, hi)
     }
 
     /// The box around every triangle (the root's box); an empty tree gives an inverted box.
@@ -243,7 +238,7 @@ impl Bvh {
         order: impl Fn(&S, &[f64; 3], &[f64; 3]) -> f64,
         mut visit: impl FnMut(&mut S, u32),
     ) {
-        if self.tri_lo.is_empty() {
+        if self.boxes.is_empty() {
             return;
         }
         let mut stack = [0u32; STACK];
@@ -257,7 +252,8 @@ impl Bvh {
             if node.count > 0 {
                 let leaf = &self.order[node.first as usize..(node.first + node.count) as usize];
                 for &t in leaf {
-                    if overlaps(&self.tri_lo[t as usize], &self.tri_hi[t as usize], lo, hi) {
+                    let [a, b] = &self.boxes[t as usize];
+                    if overlaps(a, b, lo, hi) {
                         visit(state, t);
                     }
                 }
@@ -278,7 +274,7 @@ impl Bvh {
         let contains = |lo: &[f64; 3], hi: &[f64; 3], clo: &[f64; 3], chi: &[f64; 3]| {
             (0..3).all(|d| lo[d] <= clo[d] && chi[d] <= hi[d])
         };
-        let mut seen = vec![0usize; self.tri_lo.len()];
+        let mut seen = vec![0usize; self.boxes.len()];
         for (k, node) in self.nodes.iter().enumerate() {
             let (first, count) = (node.first as usize, node.count as usize);
             if count > 0 {
@@ -290,11 +286,11 @@ impl Bvh {
                         return Err(BvhError::Dangling { node: k });
                     }
                     seen[tu] += 1;
-                    if !contains(&node.lo, &node.hi, &self.tri_lo[tu], &self.tri_hi[tu]) {
+                    if !contains(&node.lo, &node.hi, &self.boxes[tu][0], &self.boxes[tu][1]) {
                         return Err(BvhError::TriangleOutside { node: k, triangle: t });
                     }
                 }
-            } else if !self.tri_lo.is_empty() {
+            } else if !self.boxes.is_empty() {
                 for child in [first, first + 1] {
                     let c = self.nodes.get(child).ok_or(BvhError::Dangling { node: k })?;
                     if child <= k {
@@ -326,8 +322,7 @@ impl Bvh {
                     }
                 }
             }
-            self.tri_lo[t] = lo.map(|v| v - self.pad);
-            self.tri_hi[t] = hi.map(|v| v + self.pad);
+            self.boxes[t] = [lo.map(|v| v - self.pad), hi.map(|v| v + self.pad)];
         }
     }
 
@@ -345,9 +340,10 @@ impl Bvh {
             };
             if count > 0 {
                 for &t in &self.order[first as usize..(first + count) as usize] {
-                    grow(self.tri_lo[t as usize], self.tri_hi[t as usize]);
+                    let [lo, hi] = self.boxes[t as usize];
+                    grow(lo, hi);
                 }
-            } else if !self.tri_lo.is_empty() {
+            } else if !self.boxes.is_empty() {
                 for c in [first as usize, first as usize + 1] {
                     grow(self.nodes[c].lo, self.nodes[c].hi);
                 }
