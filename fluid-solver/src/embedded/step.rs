@@ -76,6 +76,10 @@ impl PartialEq for FluxClock {
     }
 }
 
+/// Nodes, and edges, per parallel task of [`EmbeddedStep::update`] (small in the tests, so that
+/// their meshes make several).
+const UPDATE_CHUNK: usize = if cfg!(test) { 64 } else { 4096 };
+
 /// The sorted union of two ascending lists, each value once.
 fn union_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
     let mut out = Vec::with_capacity(a.len() + b.len());
@@ -157,26 +161,40 @@ impl EmbeddedStep {
         let mesh = &semi.mesh;
         let material = semi.material();
         let cut: Vec<u32> = tracker.cuts.cuts.iter().map(|c| c.edge).collect();
-        let mut changed: Vec<u32> = Vec::new();
-        for (i, (now, before)) in tracker.active.iter().zip(&self.active).enumerate() {
-            if now != before {
-                changed.extend_from_slice(tracker.adjacency.edges_of(i));
-            }
-        }
-        changed.sort_unstable();
+        let adjacency = &tracker.adjacency;
+        let mut changed: Vec<u32> = (tracker.active.par_chunks(UPDATE_CHUNK))
+            .zip(self.active.par_chunks(UPDATE_CHUNK))
+            .enumerate()
+            .flat_map_iter(|(c, (now, before))| {
+                let first = c * UPDATE_CHUNK;
+                let moved = now.iter().zip(before).enumerate().filter(|(_, (n, b))| n != b);
+                moved.flat_map(move |(k, _)| adjacency.edges_of(first + k).iter().copied())
+            })
+            .collect();
+        changed.par_sort_unstable();
         // The cut edges before and now are each sorted: two merges.
         let edges = union_sorted(&union_sorted(&self.cut, &cut), &changed);
-        let (mut flipped, mut now) = (Vec::new(), Vec::new());
-        let mut cut_now = cut.iter().peekable();
-        for &e in &edges {
-            while cut_now.next_if(|&&c| c < e).is_some() {}
-            let is_cut = cut_now.peek() == Some(&&e);
-            let kind = EdgeKind::of(mesh.edges[e as usize], is_cut, &tracker.active, material);
-            if kind.used != self.gradient.uses(e as usize) {
-                flipped.push(e);
-            }
-            now.extend(kind.special.map(|kind| SpecialEdge { edge: e, kind }));
-        }
+        // Each run of edges walks the cut list from its first edge.
+        let parts: Vec<(Vec<u32>, Vec<SpecialEdge>)> = edges
+            .par_chunks(UPDATE_CHUNK)
+            .map(|run| {
+                let (mut flipped, mut now) = (Vec::new(), Vec::new());
+                let mut cut_now = cut[cut.partition_point(|&c| c < run[0])..].iter().peekable();
+                for &e in run {
+                    while cut_now.next_if(|&&c| c < e).is_some() {}
+                    let is_cut = cut_now.peek() == Some(&&e);
+                    let kind =
+                        EdgeKind::of(mesh.edges[e as usize], is_cut, &tracker.active, material);
+                    if kind.used != self.gradient.uses(e as usize) {
+                        flipped.push(e);
+                    }
+                    now.extend(kind.special.map(|kind| SpecialEdge { edge: e, kind }));
+                }
+                (flipped, now)
+            })
+            .collect();
+        let flipped: Vec<u32> = parts.iter().flat_map(|p| p.0.iter().copied()).collect();
+        let now: Vec<SpecialEdge> = parts.iter().flat_map(|p| p.1.iter().copied()).collect();
         self.gradient.remask(mesh, &flipped, |i| tracker.adjacency.edges_of(i));
         // The special edges that were not looked at stay as they were.
         let list = replace_sorted(self.ours.all(), &edges, &now);
