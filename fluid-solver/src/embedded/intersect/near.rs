@@ -17,9 +17,9 @@
 //! keeps them, grouped by node: each box a pass searches around node `i` (an edge of `i`, its
 //! occlusion ball, its projection box, the node itself) lies in the reach box of `i`, so the
 //! triangles recorded for `i` hold every triangle whose box meets it, and the pass tests those
-//! instead of querying the tree from its root. An edge takes the triangles of one of its ends
-//! (Alg. 4.2 its first, Alg. 4.1 the one with fewer), and none when an end is not near: that
-//! end's reach box, which holds the edge, meets no triangle box.
+//! instead of querying the tree from its root. An edge takes the triangles of its first end
+//! (read once for all the edges that end starts: [`super::crossings`]), and none when an end is
+//! not near: that end's reach box, which holds the edge, meets no triangle box.
 //!
 //! Each recorded pair also keeps which halves of the reach box, split at the node along each
 //! axis, the triangle box reaches ([`Split::halves`]). A query box on one side of the node along an
