@@ -54,14 +54,14 @@ fn collision_grouped<const G: usize>(
 ) -> Intersections {
     debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     let occluded = at.occluded(mesh, &adjacency.h_min, true, near);
+    let pass = Pass { mesh, adjacency, at, near, occluded: &occluded };
     let cuts: Vec<CutEdge> = near
         .nodes
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
             let (mut cuts, mut ends) = (Vec::new(), Vec::new());
             for &i in chunk {
-                let i = i as usize;
-                node_cuts::<G>(mesh, adjacency, at, near, &occluded, i, &mut ends, &mut cuts);
+                pass.node_cuts::<G>(i as usize, &mut ends, &mut cuts);
             }
             cuts
         })
@@ -69,61 +69,57 @@ fn collision_grouped<const G: usize>(
     Intersections::from_sorted(mesh, cuts, occluded)
 }
 
-/// The cuts of the edges `[i, j]` of node `i` with `j > i` near, in edge order: each edge's
-/// crossing nearest to node `i` (step 4, [`SurfaceAt::for_each_crossing_from`] by groups of
-/// `G`), else its occluded end (step 4.2); `ends` is a buffer.
-#[allow(clippy::too_many_arguments)]
-fn node_cuts<const G: usize>(
-    mesh: &Mesh,
-    adjacency: &NodeEdges,
-    at: SurfaceAt<'_>,
-    near: &Near,
-    occluded: &[bool],
-    i: usize,
-    ends: &mut Vec<(usize, usize)>,
-    cuts: &mut Vec<CutEdge>,
-) {
-    ends.clear();
-    for &e in adjacency.owned_by(i) {
-        let j = mesh.edges[e as usize][1] as usize;
-        if !near.triangles_of(j).is_some_and(|l| l.is_empty()) {
-            ends.push((e as usize, j));
-        }
-    }
-    at.for_each_crossing_from::<G>(mesh, near, i, ends, true, |e, best| {
-        edge_cut(mesh, adjacency, at, near, occluded, e, best, cuts)
-    });
+/// What the cuts of one pass read: the mesh, the surface, the near part and the occluded nodes.
+#[derive(Clone, Copy)]
+struct Pass<'a> {
+    mesh: &'a Mesh,
+    adjacency: &'a NodeEdges,
+    at: SurfaceAt<'a>,
+    near: &'a Near,
+    occluded: &'a [bool],
 }
 
-/// The cut of edge `e` from its nearest crossing `best` (step 4), else at its occluded end
-/// (step 4.2), if any.
-#[allow(clippy::too_many_arguments)]
-fn edge_cut(
-    mesh: &Mesh,
-    adjacency: &NodeEdges,
-    at: SurfaceAt<'_>,
-    near: &Near,
-    occluded: &[bool],
-    e: usize,
-    best: Option<Crossing>,
-    cuts: &mut Vec<CutEdge>,
-) {
-    if let Some(c) = best {
-        cuts.push(c.cut(&at, e));
-        return;
-    }
-    let [i, j] = mesh.edges[e].map(|v| v as usize);
-    // Step 4.2: the occluded end is the intersection point.
-    for (end, alpha) in [(i, 0.0), (j, 1.0)] {
-        if occluded[end] {
-            let r = super::OCCLUSION * adjacency.h_min[end];
-            if let Some((t, cp)) =
-                at.nearest_point(mesh.coords[end], r, true, Some((near, end)), None)
-            {
-                cuts.push(at.cut(e, t, alpha, cp.bary));
-                return;
+impl Pass<'_> {
+    /// Adds to `cuts` the cuts of the edges `[i, j]` of node `i` with `j > i` near, in edge
+    /// order: each edge's crossing nearest to node `i` (step 4,
+    /// [`SurfaceAt::for_each_crossing_from`] by groups of `G`), else its occluded end (step 4.2);
+    /// `ends` is a buffer.
+    fn node_cuts<const G: usize>(
+        &self,
+        i: usize,
+        ends: &mut Vec<(usize, usize)>,
+        cuts: &mut Vec<CutEdge>,
+    ) {
+        let (mesh, near) = (self.mesh, self.near);
+        ends.clear();
+        for &e in self.adjacency.owned_by(i) {
+            let j = mesh.edges[e as usize][1] as usize;
+            if !near.triangles_of(j).is_some_and(|l| l.is_empty()) {
+                ends.push((e as usize, j));
             }
         }
+        self.at.for_each_crossing_from::<G>(mesh, near, i, ends, true, |e, best| {
+            cuts.extend(self.edge_cut(e, best))
+        });
+    }
+
+    /// The cut of edge `e` from its nearest crossing `best` (step 4), else at its occluded end
+    /// (step 4.2), if any.
+    fn edge_cut(&self, e: usize, best: Option<Crossing>) -> Option<CutEdge> {
+        let at = &self.at;
+        if let Some(c) = best {
+            return Some(c.cut(at, e));
+        }
+        let [i, j] = self.mesh.edges[e].map(|v| v as usize);
+        // Step 4.2: the occluded end is the intersection point.
+        [(i, 0.0), (j, 1.0)].into_iter().filter(|&(end, _)| self.occluded[end]).find_map(
+            |(end, alpha)| {
+                let r = super::OCCLUSION * self.adjacency.h_min[end];
+                let p = self.mesh.coords[end];
+                let (t, cp) = at.nearest_point(p, r, true, Some((self.near, end)), None)?;
+                Some(at.cut(e, t, alpha, cp.bary))
+            },
+        )
     }
 }
 
