@@ -26,6 +26,7 @@ pub mod levelset;
 pub mod memory;
 pub mod mesh;
 pub mod output;
+pub mod prefetch;
 pub mod probes;
 pub mod reconstruct;
 pub mod riemann;

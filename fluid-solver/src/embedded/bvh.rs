@@ -207,6 +207,12 @@ impl Bvh {
         (lo, hi)
     }
 
+    /// Prefetch hint ([`crate::prefetch`]) for the box of triangle `t`.
+    #[inline]
+    pub fn prefetch_box(&self, t: usize) {
+        crate::prefetch::prefetch(&self.boxes, t);
+    }
+
     /// The box around every triangle (the root's box); an empty tree gives an inverted box.
     pub fn root_box(&self) -> ([f64; 3], [f64; 3]) {
         self.nodes.first().map_or(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |r| (r.lo, r.hi))

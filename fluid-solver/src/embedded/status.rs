@@ -161,28 +161,50 @@ pub fn swept_nodes_among(
     bvh: &Bvh,
     candidates: &[u32],
 ) -> Vec<u32> {
-    swept_in(mesh, surface, bvh, candidates, |p, _, visit| bvh.for_each_overlap(p, p, visit))
+    swept_in(
+        mesh,
+        surface,
+        bvh,
+        candidates,
+        |_| (),
+        |p, _, visit| bvh.for_each_overlap(p, p, visit),
+    )
 }
 
 /// [`swept_nodes`] among the nodes of `near` ([`Near::find`] over `bvh`), each tested against
 /// the triangles recorded for it (a node is inside its reach box).
 pub fn swept_nodes_near(mesh: &Mesh, surface: &Surface, bvh: &Bvh, near: &Near) -> Vec<u32> {
-    swept_in(mesh, surface, bvh, &near.nodes, |p, i, visit| {
-        near.for_each_overlap(bvh, i, p, p, p, visit)
-    })
+    swept_in(
+        mesh,
+        surface,
+        bvh,
+        &near.nodes,
+        |k| near.prefetch_ahead(mesh, &near.nodes, k),
+        |p, i, visit| near.for_each_overlap(bvh, i, p, p, p, visit),
+    )
 }
 
 /// The nodes of `candidates` a triangle passed over, the triangles whose box holds node `i` at
-/// `p` given by `query(p, i, visit)`.
-fn swept_in<Q>(mesh: &Mesh, surface: &Surface, bvh: &Bvh, candidates: &[u32], query: Q) -> Vec<u32>
+/// `p` given by `query(p, i, visit)`; `ahead(k)` is called before the `k`-th candidate (prefetch
+/// hints).
+fn swept_in<A, Q>(
+    mesh: &Mesh,
+    surface: &Surface,
+    bvh: &Bvh,
+    candidates: &[u32],
+    ahead: A,
+    query: Q,
+) -> Vec<u32>
 where
+    A: Fn(usize) + Sync,
     Q: Fn(&[f64; 3], usize, &mut dyn FnMut(u32)) + Sync,
 {
     debug_assert_eq!(bvh.len(), surface.triangles.len(), "hierarchy of another surface");
     candidates
         .par_iter()
-        .copied()
-        .filter(|&i| {
+        .enumerate()
+        .filter_map(|(k, &i)| {
+            ahead(k);
             let p = mesh.coords[i as usize];
             let mut swept = false;
             query(&p, i as usize, &mut |t| {
@@ -193,7 +215,7 @@ where
                     swept = sweep_over_point(p, from, to).is_some();
                 }
             });
-            swept
+            swept.then_some(i)
         })
         .collect()
 }

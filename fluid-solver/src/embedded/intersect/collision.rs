@@ -13,10 +13,12 @@
 //! Doubly cut edges of thin bodies are found, and an open surface needs no inside.
 
 use super::crossings::GROUP;
+use super::near::AHEAD;
 use super::{Crossing, Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::CutEdge;
 use crate::mesh::Mesh;
+use crate::prefetch::prefetch;
 use rayon::prelude::*;
 
 /// Near nodes per parallel task.
@@ -60,7 +62,8 @@ fn collision_grouped<const G: usize>(
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
             let (mut cuts, mut ends) = (Vec::new(), Vec::new());
-            for &i in chunk {
+            for (k, &i) in chunk.iter().enumerate() {
+                pass.prefetch_ahead(chunk, k);
                 pass.node_cuts::<G>(i as usize, &mut ends, &mut cuts);
             }
             cuts
@@ -80,6 +83,37 @@ struct Pass<'a> {
 }
 
 impl Pass<'_> {
+    /// Prefetch hints ([`crate::prefetch`]) for the nodes after `nodes[k]`, each row a few
+    /// nodes before the loads that depend on it: the near part's ([`Near::prefetch_ahead`]),
+    /// the bounds of the owned edges, the owned edges, their ends, the ends' coordinates and
+    /// list bounds.
+    #[inline]
+    fn prefetch_ahead(&self, nodes: &[u32], k: usize) {
+        let (mesh, adjacency, near) = (self.mesh, self.adjacency, self.near);
+        near.prefetch_ahead(mesh, nodes, k);
+        let at = |d: usize| nodes.get(k + d).map(|&i| i as usize);
+        if let Some(i) = at(AHEAD) {
+            adjacency.prefetch_owned(i, false);
+        }
+        if let Some(i) = at(AHEAD / 2) {
+            adjacency.prefetch_owned(i, true);
+        }
+        if let Some(i) = at(2) {
+            for e in
+                [adjacency.owned_by(i).first(), adjacency.owned_by(i).last()].into_iter().flatten()
+            {
+                prefetch(&mesh.edges, *e as usize);
+            }
+        }
+        if let Some(i) = at(1) {
+            for &e in adjacency.owned_by(i) {
+                let j = mesh.edges[e as usize][1] as usize;
+                prefetch(&mesh.coords, j);
+                near.prefetch_list(j, false);
+            }
+        }
+    }
+
     /// Adds to `cuts` the cuts of the edges `[i, j]` of node `i` with `j > i` near, in edge
     /// order: each edge's crossing nearest to node `i` (step 4,
     /// [`SurfaceAt::for_each_crossing_from`] by groups of `G`), else its occluded end (step 4.2);

@@ -270,7 +270,9 @@ impl SurfaceAt<'_> {
         let nodes = &near.nodes;
         let hit: Vec<bool> = nodes
             .par_iter()
-            .map(|&i| {
+            .enumerate()
+            .map(|(k, &i)| {
+                near.prefetch_ahead(mesh, nodes, k);
                 let i = i as usize;
                 let r = OCCLUSION * h_min[i];
                 r.is_finite()

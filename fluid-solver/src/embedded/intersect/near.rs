@@ -31,10 +31,16 @@ use super::OCCLUSION;
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
+use crate::prefetch::prefetch;
 
 /// Nodes per parallel task of the list passes (a few thousand near nodes of long lists make
 /// several tasks).
 const CHUNK: usize = 256;
+
+/// Places ahead in its node list at which a pass hints the rows it will read
+/// ([`Near::prefetch_ahead`]): the near nodes lie scattered over the mesh arrays, and each
+/// node's rows are a chain of loads (bounds, then list).
+pub const AHEAD: usize = 8;
 
 /// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
 #[derive(Debug, Clone, PartialEq)]
@@ -255,6 +261,32 @@ impl Near {
             }
         }
         edges
+    }
+
+    /// Prefetch hints ([`crate::prefetch`]) for a pass at place `k` of `nodes`: the coordinates
+    /// and list bounds of the node [`AHEAD`] places on, the list of the node half as far.
+    #[inline]
+    pub fn prefetch_ahead(&self, mesh: &Mesh, nodes: &[u32], k: usize) {
+        if let Some(&i) = nodes.get(k + AHEAD) {
+            prefetch(&mesh.coords, i as usize);
+            self.prefetch_list(i as usize, false);
+        }
+        if let Some(&i) = nodes.get(k + AHEAD / 2) {
+            self.prefetch_list(i as usize, true);
+        }
+    }
+
+    /// Prefetch hints ([`crate::prefetch`]) for the list of node `i`: its bounds, then (once
+    /// those are in cache) the list.
+    #[inline]
+    pub fn prefetch_list(&self, i: usize, list: bool) {
+        match self.offsets.get(i) {
+            Some(&a) if list => {
+                prefetch(&self.triangles, a as usize);
+                prefetch(&self.halves, a as usize);
+            }
+            _ => prefetch(&self.offsets, i),
+        }
     }
 
     /// The triangles whose box meets the reach box of node `i`, if recorded ([`Near::find`]).

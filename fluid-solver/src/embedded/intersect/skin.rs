@@ -3,24 +3,35 @@
 //!
 //! The triangles are kept by *runs* of consecutive numbers, each with the box around its
 //! triangles' boxes (the longest runs up to [`MAX_RUN`] whose boxes are on average no wider than
-//! twice the skin, chosen at each rebuild). At a rebuild every run box is widened by the skin `δ`
-//! and the pairs of reach boxes and widened run boxes are found by the search [`Near::find`] uses
-//! ([`pairs_by_node`]). While each run's current box stays inside its widened one, a triangle
-//! whose box meets a reach box now lies in a run kept for that node, so filtering the kept runs by
-//! their current boxes, and the triangles of the runs that pass by theirs, gives exactly the pairs
-//! of a fresh search, in ascending order: [`NearSkin::find`] equals [`Near::find`] (tested), at
-//! the cost of a linear pass. A run that leaves its widened box, a new topology or a new hierarchy
-//! size triggers the next rebuild. Nothing here is state of the run: a restarted run rebuilds at
-//! its first step and gets the same [`Near`].
+//! twice the skin, chosen at each rebuild). At a rebuild every run box is widened, and the pairs
+//! of reach boxes and widened run boxes are found by the search [`Near::find`] uses
+//! ([`pairs_by_node`]). The widening follows the motion: a run box moved by `m` since the last
+//! call is stretched by `k m` ahead of it and by the slack `σ` on every side, with `k` such that
+//! the fastest run is stretched by the skin `δ` (a surface moving at a steady velocity keeps
+//! its pairs for as many steps as a skin of `δ` on every side would, with far fewer pairs: the
+//! skin lies only where the surface is going). Without a last call of the same runs (the first,
+//! a new topology or a new run length) every side is widened by `δ`. While each run's current
+//! box stays inside its widened one, a triangle whose box meets a reach box now lies in a run
+//! kept for that node, so filtering the kept runs by their current boxes, and the triangles of
+//! the runs that pass by theirs, gives exactly the pairs of a fresh search, in ascending order:
+//! [`NearSkin::find`] equals [`Near::find`] (tested), at the cost of a linear pass. A run that
+//! leaves its widened box (a turning surface, one that speeds up), a new topology or a new
+//! hierarchy size triggers the next rebuild. Nothing here is state of the run: a restarted run
+//! rebuilds at its first step and gets the same [`Near`].
 
-use super::near::{pairs_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split};
+use super::near::{pairs_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split, AHEAD};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
+use crate::prefetch::prefetch;
 
-/// Skin width relative to the mean shortest edge at the mesh nodes: a surface moving a tenth of
-/// a cell per step rebuilds about every fifth step.
+/// Skin width `δ` relative to the mean shortest edge at the mesh nodes: a surface moving a
+/// tenth of a cell per step rebuilds about every fifth step.
 pub const SKIN: f64 = 0.5;
+
+/// Slack `σ` on every side relative to the same edge (module docs): room for a surface that
+/// turns a little.
+pub const SLACK: f64 = 0.0625;
 
 /// Most consecutive triangles kept together (module docs): surfaces numbered row by row
 /// (generated grids, most mesh files) make runs a few triangles across.
@@ -29,8 +40,10 @@ pub const MAX_RUN: usize = 16;
 /// Node-triangle pairs within the skin, grouped by node (module docs).
 #[derive(Debug, Clone, Default)]
 pub struct NearSkin {
-    /// Width added on every side of every run box at a rebuild.
+    /// Width added ahead of the motion ([`SKIN`]) and on every side ([`SLACK`]) of every run
+    /// box at a rebuild.
     skin: f64,
+    slack: f64,
     /// Triangles per run.
     run: usize,
     /// The widened run boxes of the last rebuild, and the number of triangles then.
@@ -43,6 +56,9 @@ pub struct NearSkin {
     kept: Vec<u32>,
     /// The nodes with kept triangles, ascending.
     kept_nodes: Vec<u32>,
+    /// The run boxes of the last call, whose change to the next call's is the motion a rebuild
+    /// widens ahead (module docs).
+    last: RunBoxes,
     /// Rebuilds so far (run statistics).
     pub rebuilds: usize,
 }
@@ -54,7 +70,7 @@ impl NearSkin {
         let finite = adjacency.h_min.iter().filter(|h| h.is_finite());
         let (sum, n) = finite.fold((0.0, 0usize), |(s, n), h| (s + h, n + 1));
         let h = if n > 0 { sum / n as f64 } else { 0.0 };
-        NearSkin { skin: SKIN * h, run: 1, ..NearSkin::default() }
+        NearSkin { skin: SKIN * h, slack: SLACK * h, run: 1, ..NearSkin::default() }
     }
 
     /// Whether the kept pairs hold every overlapping pair of `bvh`'s current boxes, whose run
@@ -67,21 +83,29 @@ impl NearSkin {
             })
     }
 
-    /// Widens the current run boxes `runs` of `bvh` and keeps the pairs they make with the reach
-    /// boxes.
+    /// Widens the current run boxes of `bvh` and keeps the pairs they make with the reach boxes:
+    /// by [`SLACK`] on every side and by the motion since the last call scaled to [`SKIN`] for
+    /// the fastest run (module docs), or by [`SKIN`] on every side without a last call of the
+    /// same runs (the first, a new topology or a new run length).
     fn rebuild(&mut self, boxes: &NodeBoxes, bvh: &Bvh) {
-        let s = self.skin;
+        let last_run = self.run;
         self.run = 1;
         let mut runs = RunBoxes::new(bvh, 1);
         while self.run < MAX_RUN {
             let longer = RunBoxes::new(bvh, 2 * self.run);
-            if longer.mean_width() > 2.0 * s {
+            if longer.mean_width() > 2.0 * self.skin {
                 break;
             }
             (self.run, runs) = (2 * self.run, longer);
         }
-        self.lo = runs.lo.iter().map(|lo| lo.map(|v| v - s)).collect();
-        self.hi = runs.hi.iter().map(|hi| hi.map(|v| v + s)).collect();
+        let same = self.run == last_run
+            && self.last.lo.len() == runs.lo.len()
+            && self.topology_version == bvh.topology_version;
+        (self.lo, self.hi) = if same {
+            runs.widened_ahead(&self.last, self.skin, self.slack)
+        } else {
+            runs.widened(self.skin)
+        };
         self.triangles = bvh.len();
         self.topology_version = bvh.topology_version;
         let widened = Bvh::over_boxes(self.lo.clone(), self.hi.clone());
@@ -98,12 +122,20 @@ impl NearSkin {
             self.rebuild(boxes, bvh);
             runs = RunBoxes::new(bvh, self.run);
         }
+        self.last = runs;
+        let runs = &self.last;
         let run = self.run;
         let rho = boxes.rho;
         let n = bvh.len();
         let chunks: Vec<Lists> = par_node_chunks(&self.kept_nodes, |nodes| {
             let mut lists = Lists::default();
-            for &i in nodes {
+            for (k, &i) in nodes.iter().enumerate() {
+                if let Some(&ahead) = nodes.get(k + AHEAD) {
+                    let ahead = ahead as usize;
+                    boxes.tree.prefetch_box(ahead);
+                    prefetch(&mesh.coords, ahead);
+                    prefetch(&self.offsets, ahead);
+                }
                 let i_ = i as usize;
                 let start = lists.len();
                 let (lo, hi) = boxes.tree.triangle_box(i_);
@@ -137,10 +169,13 @@ impl NearSkin {
             + size_of_val(&self.offsets[..])
             + size_of_val(&self.kept[..])
             + size_of_val(&self.kept_nodes[..])
+            + size_of_val(&self.last.lo[..])
+            + size_of_val(&self.last.hi[..])
     }
 }
 
 /// The box around the triangle boxes of each run of `run` triangles of a hierarchy.
+#[derive(Debug, Clone, Default)]
 struct RunBoxes {
     lo: Vec<[f64; 3]>,
     hi: Vec<[f64; 3]>,
@@ -163,6 +198,34 @@ impl RunBoxes {
             })
             .unzip();
         RunBoxes { lo, hi }
+    }
+
+    /// Every box widened by `skin` on every side.
+    fn widened(&self, skin: f64) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let lo = self.lo.iter().map(|lo| lo.map(|v| v - skin)).collect();
+        let hi = self.hi.iter().map(|hi| hi.map(|v| v + skin)).collect();
+        (lo, hi)
+    }
+
+    /// Every box widened by `slack` on every side and stretched ahead by its motion since
+    /// `last` (the same runs), scaled so the fastest moves `skin`.
+    fn widened_ahead(
+        &self,
+        last: &RunBoxes,
+        skin: f64,
+        slack: f64,
+    ) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let motion = |now: &[[f64; 3]], then: &[[f64; 3]]| -> Vec<[f64; 3]> {
+            now.iter().zip(then).map(|(a, b)| [0, 1, 2].map(|d| a[d] - b[d])).collect()
+        };
+        let (down, up) = (motion(&self.lo, &last.lo), motion(&self.hi, &last.hi));
+        let fastest = down.iter().chain(&up).flatten().fold(0.0, |m: f64, v| m.max(v.abs()));
+        let scale = if fastest > 0.0 && fastest.is_finite() { skin / fastest } else { 0.0 };
+        let lo = self.lo.iter().zip(&down);
+        let lo = lo.map(|(lo, m)| [0, 1, 2].map(|d| lo[d] - slack + (scale * m[d]).min(0.0)));
+        let hi = self.hi.iter().zip(&up);
+        let hi = hi.map(|(hi, m)| [0, 1, 2].map(|d| hi[d] + slack + (scale * m[d]).max(0.0)));
+        (lo.collect(), hi.collect())
     }
 
     /// The mean over the runs of the widest side of the box (0 for none).
@@ -209,6 +272,54 @@ mod tests {
         }
         // Each of the three jumps left the skin.
         assert_eq!(skin.rebuilds, 4);
+    }
+
+    /// A sphere moving at a steady velocity and one circling an axis: the skin's near part equals
+    /// a fresh traversal every step; the steady one keeps its pairs as many steps as a skin on
+    /// every side would (no more rebuilds) with far fewer pairs kept.
+    #[test]
+    fn the_skin_ahead_of_the_motion_keeps_fewer_pairs_for_as_long() {
+        let mesh = cube_mesh(14, 0.3, 5);
+        let adj = NodeEdges::build(&mesh);
+        let boxes = NodeBoxes::build(&mesh, &adj);
+        let rest = sphere([0.4, 0.45, 0.5], 0.2, 10);
+        let h = 1.0 / 14.0;
+        let steady = |k: usize| [0.04 * h * k as f64, 0.01 * h * k as f64, 0.0];
+        let circling = |k: usize| {
+            let a = 0.05 * k as f64;
+            [0.1 * (a.cos() - 1.0), 0.1 * a.sin(), 0.0]
+        };
+        let run = |motion: &dyn Fn(usize) -> [f64; 3], steps: usize, ahead: bool| {
+            let mut surface = rest.clone();
+            let mut bvh = Bvh::build(&surface, 1e-4);
+            let mut skin = NearSkin::new(&adj);
+            let mut kept = Vec::new();
+            for k in 1..=steps {
+                let m = motion(k);
+                let x: Vec<[f64; 3]> =
+                    rest.x_b.iter().map(|p| [0, 1, 2].map(|d| p[d] + m[d])).collect();
+                surface.advance(0.01 * k as f64, &x, &vec![[0.0; 3]; x.len()]);
+                bvh.update(&surface);
+                if !ahead {
+                    // No last call: every rebuild widens every side.
+                    skin.last = RunBoxes::default();
+                }
+                let fresh = Near::find(&mesh, &boxes, &bvh);
+                assert_eq!(skin.find(&mesh, &boxes, &bvh), fresh, "step {k}");
+                kept.push(skin.kept.len());
+            }
+            (skin.rebuilds, kept)
+        };
+        let (rebuilds, kept) = run(&steady, 60, true);
+        let (rebuilds_around, kept_around) = run(&steady, 60, false);
+        assert!(rebuilds > 2 && rebuilds <= rebuilds_around, "{rebuilds} vs {rebuilds_around}");
+        let mean = |k: &[usize]| k.iter().sum::<usize>() as f64 / k.len() as f64;
+        // The steps after the first rebuild ahead of the motion.
+        let after = kept.iter().position(|&k| k != kept[0]).unwrap();
+        let ratio = mean(&kept[after..]) / mean(&kept_around[after..]);
+        assert!(ratio < 0.8, "kept {ratio} of the pairs");
+        let (turning, _) = run(&circling, 60, true);
+        assert!(turning > 2, "{turning} rebuilds");
     }
 
     /// A finely meshed plate (runs of several triangles) and the same plate with its triangles
