@@ -15,6 +15,7 @@ pub mod collision;
 mod crossings;
 pub mod near;
 pub mod projection;
+mod pseudo_normals;
 pub mod skin;
 
 pub use collision::{collision, collision_near};

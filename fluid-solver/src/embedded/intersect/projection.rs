@@ -21,11 +21,12 @@
 
 use super::closest::Nearest;
 use super::crossings::GROUP;
+use super::pseudo_normals::PseudoNormals;
 use super::{Intersections, Near, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
-use crate::embedded::predicates::{closest_point, unit_normal, Feature};
+use crate::embedded::predicates::{closest_point, Closest};
 use crate::embedded::CutEdge;
-use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
+use crate::mesh::geometry::{add, dot, norm, scale, sub};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 
@@ -365,8 +366,8 @@ fn decide(
     if nodes.is_empty() {
         return Vec::new();
     }
-    let normals = PseudoNormals::new(at);
-    nodes
+    // The closest points first, then the normals of the features they lie on.
+    let closest: Vec<Option<(u32, Closest)>> = nodes
         .par_iter()
         .map(|&i| {
             let i = i as usize;
@@ -400,6 +401,16 @@ fn decide(
                 let radius = r * (1.0 + 1e-12) + f64::MIN_POSITIVE;
                 (t, cp) = at.nearest_point(p, radius, false, None, Some((t, cp)))?;
             }
+            Some((t, cp))
+        })
+        .collect();
+    let normals = PseudoNormals::of(at, closest.iter().flatten().map(|&(t, cp)| (t, cp.feature)));
+    closest
+        .par_iter()
+        .zip(nodes)
+        .map(|(closest, &i)| {
+            let (t, cp) = (*closest)?;
+            let p = mesh.coords[i as usize];
             let [a, b, c] = at.corners(t);
             let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
             Some((dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0, cp.dist2.sqrt()))
@@ -435,74 +446,14 @@ fn flood(
     inside.into_iter().map(|s| s.unwrap_or(false)).collect()
 }
 
-/// Face, edge and vertex normals of the surface at one set of positions.
-struct PseudoNormals<'a> {
-    face: Vec<[f64; 3]>,
-    /// Per triangle, the normal of its edge opposite each corner.
-    edge: Vec<[[f64; 3]; 3]>,
-    vertex: Vec<[f64; 3]>,
-    triangles: &'a [[u32; 3]],
-}
-
-impl<'a> PseudoNormals<'a> {
-    fn new(at: SurfaceAt<'a>) -> PseudoNormals<'a> {
-        let tris = &at.surface.triangles;
-        let face: Vec<[f64; 3]> = (0..tris.len() as u32)
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|t| {
-                let [a, b, c] = at.corners(t);
-                unit_normal(a, b, c)
-            })
-            .collect();
-        // Each corner's share of its vertex normal (the face normal times the corner angle), in
-        // parallel, then summed per vertex in triangle order.
-        let shares: Vec<[[f64; 3]; 3]> = (0..tris.len() as u32)
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|t| {
-                let c = at.corners(t);
-                [0, 1, 2].map(|k| {
-                    let (u, w) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
-                    scale(face[t as usize], norm(cross(u, w)).atan2(dot(u, w)))
-                })
-            })
-            .collect();
-        let mut vertex = vec![[0.0; 3]; at.x.len()];
-        for (tri, share) in tris.iter().zip(&shares) {
-            for k in 0..3 {
-                let v = tri[k] as usize;
-                vertex[v] = add(vertex[v], share[k]);
-            }
-        }
-        // Edge normals: the faces sharing each edge, summed.
-        let mut edge = vec![[[0.0; 3]; 3]; tris.len()];
-        for run in at.surface.edges.runs() {
-            let n = run.iter().fold([0.0; 3], |s, &(t, _)| add(s, face[t as usize]));
-            for &(t, k) in run {
-                edge[t as usize][k as usize] = n;
-            }
-        }
-        PseudoNormals { face, edge, vertex, triangles: tris }
-    }
-
-    #[inline]
-    fn at(&self, t: u32, feature: Feature) -> [f64; 3] {
-        let t = t as usize;
-        match feature {
-            Feature::Face => self.face[t],
-            Feature::Edge(k) => self.edge[t][k as usize],
-            Feature::Vertex(k) => self.vertex[self.triangles[t][k as usize] as usize],
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::embedded::bvh::Bvh;
     use crate::embedded::intersect::NodeBoxes;
+    use crate::embedded::predicates::{unit_normal, Feature};
     use crate::embedded::tests::{box_surface, cube_mesh, sphere};
+    use crate::mesh::geometry::{cross, norm};
 
     /// Steps 1-3 before the search was pruned: every triangle whose box meets the node box, then
     /// every triangle whose box meets the ball's box, each closest point computed.
@@ -512,7 +463,6 @@ mod tests {
         at: SurfaceAt<'_>,
         i: usize,
     ) -> Option<bool> {
-        let normals = PseudoNormals::new(at);
         let p = mesh.coords[i];
         let nearest = |lo, hi| crate::embedded::intersect::closest::brute_nearest(&at, p, lo, hi);
         let (lo, hi) = adjacency.node_box(mesh, i);
@@ -524,7 +474,37 @@ mod tests {
         }
         let [a, b, c] = at.corners(t);
         let x = add(add(scale(a, cp.bary[0]), scale(b, cp.bary[1])), scale(c, cp.bary[2]));
-        Some(dot(sub(p, x), normals.at(t, cp.feature)) <= 0.0)
+        Some(dot(sub(p, x), every_normal(at, t, cp.feature)) <= 0.0)
+    }
+
+    /// The pseudo-normal of `feature` of triangle `t` from the normals of every feature.
+    fn every_normal(at: SurfaceAt<'_>, t: u32, feature: Feature) -> [f64; 3] {
+        let tris = &at.surface.triangles;
+        let face: Vec<[f64; 3]> = (0..tris.len() as u32)
+            .map(|t| {
+                let [a, b, c] = at.corners(t);
+                unit_normal(a, b, c)
+            })
+            .collect();
+        match feature {
+            Feature::Face => face[t as usize],
+            Feature::Edge(k) => {
+                let run = at.surface.edges.runs().find(|run| run.contains(&(t, k))).unwrap();
+                run.iter().fold([0.0; 3], |s, &(t, _)| add(s, face[t as usize]))
+            }
+            Feature::Vertex(k) => {
+                let v = tris[t as usize][k as usize];
+                let mut n = [0.0; 3];
+                for (t, tri) in tris.iter().enumerate() {
+                    for k in (0..3).filter(|&k| tri[k] == v) {
+                        let c = at.corners(t as u32);
+                        let (u, w) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
+                        n = add(n, scale(face[t], norm(cross(u, w)).atan2(dot(u, w))));
+                    }
+                }
+                n
+            }
+        }
     }
 
     /// The pruned steps 1-3 decide every near node as the unpruned search does, over the
