@@ -241,25 +241,50 @@ impl KeptInside {
             }
         }
         let inside = &self.inside;
-        let mut in_d = vec![false; mesh.n_nodes()];
+        // Per node: 0 not near, 1 near and undecided, 2 near and decided.
+        let mut state = vec![0u8; mesh.n_nodes()];
         for (&i, d) in near.nodes.iter().zip(decided) {
-            in_d[i as usize] = d.is_some();
+            state[i as usize] = 1 + u8::from(d.is_some());
         }
-        let in_d = |i: u32| in_d[i as usize];
+        let decided_at = |i: u32| state[i as usize] == 2;
         let breaks_a = |&e: &u32| {
             let [i, j] = mesh.edges[e as usize];
-            differs(mesh, inside, e) && !(in_d(i) && in_d(j))
+            differs(mesh, inside, e) && !(decided_at(i) && decided_at(j))
         };
-        let near_edges = near.edges(mesh, adjacency);
-        if !reached.iter().all(|r| *r)
-            || near_edges.par_iter().any(breaks_a)
-            || self.differ.par_iter().any(breaks_a)
-        {
+        if !reached.iter().all(|r| *r) || self.differ.par_iter().any(breaks_a) {
             return false;
         }
-        self.differ =
-            near_edges.par_iter().copied().filter(|&e| differs(mesh, inside, e)).collect();
-        true
+        // Every edge touching a near node, once: from its first end when that end is near. A
+        // differing edge with both ends decided has both ends near, so the kept ones come from
+        // their first ends, node by node in order: ascending.
+        let differ: Vec<Option<Vec<u32>>> = near
+            .nodes
+            .par_chunks(CHUNK)
+            .map(|nodes| {
+                let mut differ = Vec::new();
+                for &v in nodes {
+                    for (u, e) in adjacency.neighbours(mesh, v as usize) {
+                        if (u as u32) < v && state[u] != 0 {
+                            continue;
+                        }
+                        if differs(mesh, inside, e) {
+                            if !(decided_at(v) && decided_at(u as u32)) {
+                                return None;
+                            }
+                            differ.push(e);
+                        }
+                    }
+                }
+                Some(differ)
+            })
+            .collect();
+        match differ.into_iter().collect::<Option<Vec<Vec<u32>>>>() {
+            Some(parts) => {
+                self.differ = parts.concat();
+                true
+            }
+            None => false,
+        }
     }
 
     /// Memory in bytes.
