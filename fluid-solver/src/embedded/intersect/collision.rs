@@ -99,10 +99,9 @@ impl Pass<'_> {
             adjacency.prefetch_owned(i, true);
         }
         if let Some(i) = at(2) {
-            for e in
-                [adjacency.owned_by(i).first(), adjacency.owned_by(i).last()].into_iter().flatten()
-            {
-                prefetch(&mesh.edges, *e as usize);
+            let owned = adjacency.owned_by(i);
+            for &e in owned.first().into_iter().chain(owned.last()) {
+                prefetch(&mesh.edges, e as usize);
             }
         }
         if let Some(i) = at(1) {
