@@ -475,10 +475,10 @@ fn flood(
 mod tests {
     use super::*;
     use crate::embedded::bvh::Bvh;
+    use crate::embedded::intersect::pseudo_normals::corner_angle;
     use crate::embedded::intersect::NodeBoxes;
     use crate::embedded::predicates::{unit_normal, Feature};
     use crate::embedded::tests::{box_surface, cube_mesh, sphere};
-    use crate::mesh::geometry::{cross, norm};
 
     /// Steps 1-3 before the search was pruned: every triangle whose box meets the node box, then
     /// every triangle whose box meets the ball's box, each closest point computed.
@@ -522,9 +522,7 @@ mod tests {
                 let mut n = [0.0; 3];
                 for (t, tri) in tris.iter().enumerate() {
                     for k in (0..3).filter(|&k| tri[k] == v) {
-                        let c = at.corners(t as u32);
-                        let (u, w) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
-                        n = add(n, scale(face[t], norm(cross(u, w)).atan2(dot(u, w))));
+                        n = add(n, scale(face[t], corner_angle(&at.corners(t as u32), k)));
                     }
                 }
                 n

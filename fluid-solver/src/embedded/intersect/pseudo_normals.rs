@@ -25,6 +25,13 @@ pub(super) struct PseudoNormals<'a> {
     edge: Vec<((u32, u8), [f64; 3])>,
 }
 
+/// The angle of the triangle `c` at corner `k`, the weight of its face normal in the vertex's.
+#[inline]
+pub(super) fn corner_angle(c: &[[f64; 3]; 3], k: usize) -> f64 {
+    let (u, w) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
+    norm(cross(u, w)).atan2(dot(u, w))
+}
+
 impl<'a> PseudoNormals<'a> {
     /// The normals of the features `wanted` (triangle, feature) of the surface `at`.
     pub fn of(
@@ -69,9 +76,7 @@ impl<'a> PseudoNormals<'a> {
             for k in 0..3 {
                 let v = tri[k] as usize;
                 if vertex_wanted[v] {
-                    let c = at.corners(t as u32);
-                    let (u, w) = (sub(c[(k + 1) % 3], c[k]), sub(c[(k + 2) % 3], c[k]));
-                    let share = scale(face[t], norm(cross(u, w)).atan2(dot(u, w)));
+                    let share = scale(face[t], corner_angle(&at.corners(t as u32), k));
                     vertex[v] = add(vertex[v], share);
                 }
             }
