@@ -30,14 +30,8 @@ pub struct EdgeHit {
     pub bary: [f64; 3],
 }
 
-/// The crossing of the segment `p q` with the closed triangle `(a, b, c)`, if any.
-///
-/// The segment crosses when its ends are not strictly on one side of the triangle's plane and
-/// the line `p q` passes through the closed triangle: the three orientations of `p, q` against
-/// the triangle's edges do not take both signs. A segment lying in the plane of the triangle
-/// (both ends coplanar) is not a crossing, whatever it touches. With the volumes
-/// `V_a = orient(p, q, b, c)`, `V_b = orient(p, q, c, a)`, `V_c = orient(p, q, a, b)` the
-/// barycentric coordinates are `V_k / ΣV`, and `α = s_p / (s_p - s_q)` with `s = orient(a, b, c, ·)`.
+/// The crossing of the segment `p q` with the closed triangle `(a, b, c)`, if any
+/// ([`TriangleFrom::crossing`]).
 pub fn segment_triangle(
     p: [f64; 3],
     q: [f64; 3],
@@ -45,39 +39,113 @@ pub fn segment_triangle(
     b: [f64; 3],
     c: [f64; 3],
 ) -> Option<EdgeHit> {
-    segment_triangle_from(p, q, [a, b, c], orient(a, b, c, p))
+    TriangleFrom::new(p, [a, b, c]).crossing(q)
 }
 
-/// [`segment_triangle`] given `sp = orient(a, b, c, p)`, which the segments from one point `p`
-/// against one triangle share.
-#[inline]
-pub fn segment_triangle_from(
+/// Relative bound on the rounding error of a triple product of rounded differences, above
+/// Shewchuk's `(7 + 56ε)ε` for `orient3d`'s first stage (`ε = 2⁻⁵³`): the same cofactor
+/// expansion, taken along a row of the matrix instead of a column.
+const TRIPLE_ERROR: f64 = 4.0 * f64::EPSILON;
+
+/// The cross product `u × v` of two rounded difference vectors, with the permanent of its
+/// components (`|u₁v₂| + |u₂v₁|`, …) that bounds the rounding of a triple product `w · (u × v)`.
+#[derive(Debug, Clone, Copy)]
+struct Cross {
+    uv: [f64; 3],
+    permanent: [f64; 3],
+}
+
+impl Cross {
+    #[inline]
+    fn of(u: [f64; 3], v: [f64; 3]) -> Self {
+        let pair = |k: usize, l: usize| (u[k] * v[l], u[l] * v[k]);
+        let terms = [pair(1, 2), pair(2, 0), pair(0, 1)];
+        Self { uv: terms.map(|(x, y)| x - y), permanent: terms.map(|(x, y)| x.abs() + y.abs()) }
+    }
+
+    /// `w · (u × v)` when the rounding cannot have changed its sign (then its sign is exact and
+    /// it is nonzero), else `None`.
+    #[inline]
+    fn triple(&self, w: [f64; 3]) -> Option<f64> {
+        let det = w[0] * self.uv[0] + w[1] * self.uv[1] + w[2] * self.uv[2];
+        let permanent = w[0].abs() * self.permanent[0]
+            + w[1].abs() * self.permanent[1]
+            + w[2].abs() * self.permanent[2];
+        (det.abs() > TRIPLE_ERROR * permanent).then_some(det)
+    }
+}
+
+/// A triangle `(a, b, c)` seen from the first end `p` of fluid edges: what the crossing tests of
+/// all the edges from `p` share (the triangle's normal, the side of `p`, and the three cross
+/// products of the corners seen from `p`, made at the first edge that reaches the plane).
+///
+/// Every orientation is a triple product of rounded differences, kept when its error bound
+/// ([`TRIPLE_ERROR`]) shows its sign, else replaced by the exact [`orient`]: signs are exact,
+/// and the values depend only on `p`, `q` and the corners, shared or not.
+#[derive(Debug, Clone)]
+pub struct TriangleFrom {
     p: [f64; 3],
-    q: [f64; 3],
-    [a, b, c]: [[f64; 3]; 3],
+    corners: [[f64; 3]; 3],
+    /// `(b - a) × (c - a)`.
+    normal: Cross,
+    /// `orient(a, b, c, p)`.
     sp: f64,
-) -> Option<EdgeHit> {
-    let sq = orient(a, b, c, q);
-    if (sp == 0.0 && sq == 0.0) || (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
-        return None;
+    /// `(b - p) × (c - p)`, `(c - p) × (a - p)`, `(a - p) × (b - p)`.
+    fans: Option<[Cross; 3]>,
+}
+
+impl TriangleFrom {
+    #[inline]
+    pub fn new(p: [f64; 3], corners: [[f64; 3]; 3]) -> Self {
+        let [a, b, c] = corners;
+        let normal = Cross::of(sub(b, a), sub(c, a));
+        let sp = normal.triple(sub(p, a)).unwrap_or_else(|| orient(a, b, c, p));
+        Self { p, corners, normal, sp, fans: None }
     }
-    // The line misses the closed triangle when two of the volumes take opposite signs: the
-    // third is computed only when the first two do not.
-    let opposite = |x: f64, y: f64| (x > 0.0 && y < 0.0) || (x < 0.0 && y > 0.0);
-    let (va, vb) = (orient(p, q, b, c), orient(p, q, c, a));
-    if opposite(va, vb) {
-        return None;
+
+    /// The crossing of the segment `p q` with the closed triangle, if any.
+    ///
+    /// The segment crosses when its ends are not strictly on one side of the triangle's plane
+    /// and the line `p q` passes through the closed triangle: the three orientations of `p, q`
+    /// against the triangle's edges do not take both signs. A segment lying in the plane of the
+    /// triangle (both ends coplanar) is not a crossing, whatever it touches. With the volumes
+    /// `V_a = orient(p, q, b, c)`, `V_b = orient(p, q, c, a)`, `V_c = orient(p, q, a, b)` the
+    /// barycentric coordinates are `V_k / ΣV`, and `α = s_p / (s_p - s_q)` with
+    /// `s = orient(a, b, c, ·)`.
+    #[inline]
+    pub fn crossing(&mut self, q: [f64; 3]) -> Option<EdgeHit> {
+        let ([a, b, c], p, sp) = (self.corners, self.p, self.sp);
+        let sq = self.normal.triple(sub(q, a)).unwrap_or_else(|| orient(a, b, c, q));
+        if (sp == 0.0 && sq == 0.0) || (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
+            return None;
+        }
+        let fans = self.fans.get_or_insert_with(|| {
+            let [a, b, c] = [a, b, c].map(|x| sub(x, p));
+            [Cross::of(b, c), Cross::of(c, a), Cross::of(a, b)]
+        });
+        // orient(p, q, x, y) = (q - p) · ((x - p) × (y - p)).
+        let d = sub(q, p);
+        let volume = |k: usize, x: [f64; 3], y: [f64; 3]| {
+            fans[k].triple(d).unwrap_or_else(|| orient(p, q, x, y))
+        };
+        // The line misses the closed triangle when two of the volumes take opposite signs: the
+        // third is computed only when the first two do not.
+        let opposite = |x: f64, y: f64| (x > 0.0 && y < 0.0) || (x < 0.0 && y > 0.0);
+        let (va, vb) = (volume(0, b, c), volume(1, c, a));
+        if opposite(va, vb) {
+            return None;
+        }
+        let vc = volume(2, a, b);
+        if opposite(va, vc) || opposite(vb, vc) {
+            return None;
+        }
+        let v = [va, vb, vc];
+        // Not coplanar, so the line meets the plane in one point and the volumes share one sign.
+        let sum = v[0] + v[1] + v[2];
+        let bary = [v[0] / sum, v[1] / sum, v[2] / sum];
+        let alpha = (sp / (sp - sq)).clamp(0.0, 1.0);
+        Some(EdgeHit { alpha, bary })
     }
-    let vc = orient(p, q, a, b);
-    if opposite(va, vc) || opposite(vb, vc) {
-        return None;
-    }
-    let v = [va, vb, vc];
-    // Not coplanar, so the line meets the plane in one point and the volumes share one sign.
-    let sum = v[0] + v[1] + v[2];
-    let bary = [v[0] / sum, v[1] / sum, v[2] / sum];
-    let alpha = (sp / (sp - sq)).clamp(0.0, 1.0);
-    Some(EdgeHit { alpha, bary })
 }
 
 /// The part of a triangle that holds the closest point to a node: its interior, the edge opposite
@@ -351,6 +419,64 @@ mod tests {
         // An edge ending on the triangle's face crosses it at α = 1.
         let h = segment_triangle([0.2, 0.2, 1.0], [0.2, 0.2, 0.0], A, B, C).unwrap();
         assert_eq!(h.alpha, 1.0);
+    }
+
+    /// The crossing test on exact orientations only (every volume by [`orient`]).
+    fn crossing_by_orient(p: [f64; 3], q: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> Option<EdgeHit> {
+        let (sp, sq) = (orient(a, b, c, p), orient(a, b, c, q));
+        if (sp == 0.0 && sq == 0.0) || sp * sq > 0.0 {
+            return None;
+        }
+        let v = [orient(p, q, b, c), orient(p, q, c, a), orient(p, q, a, b)];
+        if v.iter().any(|&x| x > 0.0) && v.iter().any(|&x| x < 0.0) {
+            return None;
+        }
+        let sum = v[0] + v[1] + v[2];
+        Some(EdgeHit { alpha: (sp / (sp - sq)).clamp(0.0, 1.0), bary: v.map(|x| x / sum) })
+    }
+
+    #[test]
+    fn filtered_volumes_decide_as_the_exact_orientations() {
+        // Segments through points of a triangle's edges and corners, and segments ending on its
+        // plane or a few ulps off it, from one node against many triangles: where the rounded
+        // triple products cannot show a sign the exact one decides, so hits agree one for one.
+        let mut state = 7u64;
+        let mut unit = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut hits, mut cases) = (0, 0);
+        for _ in 0..400 {
+            let tri: [[f64; 3]; 3] = [(); 3].map(|_| [unit(), unit(), 0.3 * unit()]);
+            let mut from = TriangleFrom::new([0.4, 0.45, 1.0], tri);
+            for k in 0..24 {
+                let (s, w) = (unit(), unit());
+                // A point of the triangle's boundary (edge k % 3 at s, or a corner), or inside.
+                let on = match k % 4 {
+                    0 => add(scale(tri[k % 3], 1.0 - s), scale(tri[(k + 1) % 3], s)),
+                    1 => tri[k % 3],
+                    _ => add(
+                        scale(tri[0], s * w),
+                        add(scale(tri[1], (1.0 - s) * w), scale(tri[2], 1.0 - w)),
+                    ),
+                };
+                // The segment from p through `on`, ending on it (k < 12) or past it.
+                let beyond = if k < 12 { 1.0 } else { 1.0 + unit() };
+                let q = add(from.p, scale(sub(on, from.p), beyond));
+                let q = if k % 5 == 4 { q.map(|x| x + f64::EPSILON * (unit() - 0.5)) } else { q };
+                let (got, want) = (from.crossing(q), crossing_by_orient(from.p, q, tri));
+                assert_eq!(got.is_some(), want.is_some(), "{tri:?} {q:?}");
+                if let (Some(g), Some(w)) = (got, want) {
+                    assert!((g.alpha - w.alpha).abs() < 1e-12, "{} {}", g.alpha, w.alpha);
+                    for d in 0..3 {
+                        assert!(g.bary[d] >= 0.0 && (g.bary[d] - w.bary[d]).abs() < 1e-9);
+                    }
+                    hits += 1;
+                }
+                cases += 1;
+            }
+        }
+        assert!(hits > cases / 3, "{hits} hits of {cases}");
     }
 
     #[test]

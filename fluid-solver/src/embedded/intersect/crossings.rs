@@ -7,12 +7,12 @@
 //! for each set, the edges of a group whose needed halves it holds, so one pass over the list
 //! meets every triangle with just the edges it may overlap: the triangles
 //! [`Near::for_each_overlap`] gives each edge, each tested against the edge's box and then by
-//! the exact crossing test, with the orientation of `i` against the triangle computed once for
-//! all the edges of the group.
+//! the exact crossing test, with what the tests of the group share about the triangle seen from
+//! `i` ([`TriangleFrom`]) made once.
 
 use super::{Crossing, Near, SurfaceAt};
 use crate::embedded::bvh::overlaps;
-use crate::embedded::predicates::orient;
+use crate::embedded::predicates::TriangleFrom;
 use crate::mesh::Mesh;
 
 /// Edges of one node read together (one bit each of the halves table, at most 32).
@@ -65,18 +65,18 @@ impl SurfaceAt<'_> {
                     continue;
                 }
                 let (tlo, thi) = self.bvh.triangle_box(t as usize);
-                let corners = self.corners(t);
-                // The side of node `i`, shared by the edges: computed at the first that needs it.
-                let mut sp = None;
+                // The triangle seen from node `i`, shared by the edges: made at the first that
+                // needs it.
+                let mut seen = None;
                 while hits != 0 {
                     let k = hits.trailing_zeros() as usize;
                     hits &= hits - 1;
                     let (j, lo, hi) = group[k];
                     if overlaps(&tlo, &thi, &lo, &hi) {
-                        let [a, b, c] = corners;
-                        let sp = *sp.get_or_insert_with(|| orient(a, b, c, p));
+                        let triangle =
+                            seen.get_or_insert_with(|| TriangleFrom::new(p, self.corners(t)));
                         let q = mesh.coords[j];
-                        self.offer_crossing(p, q, t, corners, sp, crack_aware, &mut best[k]);
+                        self.offer_crossing(q, t, triangle, crack_aware, &mut best[k]);
                     }
                 }
             }

@@ -24,7 +24,7 @@ pub use projection::{projection, projection_inside, projection_near, KeptInside}
 pub use skin::NearSkin;
 
 use super::bvh::Bvh;
-use super::predicates::{closest_point, orient, segment_triangle_from, unit_normal, Closest};
+use super::predicates::{closest_point, unit_normal, Closest, TriangleFrom};
 use super::{CutEdge, Surface};
 use crate::mesh::Mesh;
 use closest::Nearest;
@@ -179,30 +179,25 @@ impl SurfaceAt<'_> {
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
         let mut best = None;
         near.for_each_overlap(self.bvh, i, &p, &lo, &hi, |t| {
-            let corners = self.corners(t);
-            let [a, b, c] = corners;
-            let sp = orient(a, b, c, p);
-            self.offer_crossing(p, q, t, corners, sp, crack_aware, &mut best);
+            let mut triangle = TriangleFrom::new(p, self.corners(t));
+            self.offer_crossing(q, t, &mut triangle, crack_aware, &mut best);
         });
         best
     }
 
-    /// Tests the segment `p q` against triangle `t` at `corners` (`sp` the orientation of `p`
-    /// against it, [`orient`]) and keeps the crossing in `best` if it is nearer to `p` (smaller
-    /// α, then lower triangle), counting only hits where phi `>= 0` when `crack_aware`.
+    /// Tests the segment from `triangle`'s point to `q` against triangle `t` and keeps the
+    /// crossing in `best` if it is nearer to that point (smaller α, then lower triangle),
+    /// counting only hits where phi `>= 0` when `crack_aware`.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     fn offer_crossing(
         &self,
-        p: [f64; 3],
         q: [f64; 3],
         t: u32,
-        corners: [[f64; 3]; 3],
-        sp: f64,
+        triangle: &mut TriangleFrom,
         crack_aware: bool,
         best: &mut Option<Crossing>,
     ) {
-        if let Some(h) = segment_triangle_from(p, q, corners, sp) {
+        if let Some(h) = triangle.crossing(q) {
             if crack_aware && below_zero_or_nan(self.phi(t, h.bary)) {
                 return;
             }
