@@ -63,21 +63,28 @@ impl Cross {
         Self { uv: terms.map(|(x, y)| x - y), permanent: terms.map(|(x, y)| x.abs() + y.abs()) }
     }
 
-    /// `w · (u × v)` when the rounding cannot have changed its sign (then its sign is exact and
-    /// it is nonzero), else `None`.
+    /// `w · (u × v)` rounded, and whether the rounding cannot have changed its sign (then its
+    /// sign is exact and it is nonzero).
     #[inline]
-    fn triple(&self, w: [f64; 3]) -> Option<f64> {
+    fn triple_rounded(&self, w: [f64; 3]) -> (f64, bool) {
         let det = w[0] * self.uv[0] + w[1] * self.uv[1] + w[2] * self.uv[2];
         let permanent = w[0].abs() * self.permanent[0]
             + w[1].abs() * self.permanent[1]
             + w[2].abs() * self.permanent[2];
-        (det.abs() > TRIPLE_ERROR * permanent).then_some(det)
+        (det, det.abs() > TRIPLE_ERROR * permanent)
+    }
+
+    /// `w · (u × v)` when the rounding cannot have changed its sign, else `None`.
+    #[inline]
+    fn triple(&self, w: [f64; 3]) -> Option<f64> {
+        let (det, certain) = self.triple_rounded(w);
+        certain.then_some(det)
     }
 }
 
 /// A triangle `(a, b, c)` seen from the first end `p` of fluid edges: what the crossing tests of
 /// all the edges from `p` share (the triangle's normal, the side of `p`, and the three cross
-/// products of the corners seen from `p`, made at the first edge that reaches the plane).
+/// products of the corners seen from `p`).
 ///
 /// Every orientation is a triple product of rounded differences, kept when its error bound
 /// ([`TRIPLE_ERROR`]) shows its sign, else replaced by the exact [`orient`]: signs are exact,
@@ -91,7 +98,7 @@ pub struct TriangleFrom {
     /// `orient(a, b, c, p)`.
     sp: f64,
     /// `(b - p) × (c - p)`, `(c - p) × (a - p)`, `(a - p) × (b - p)`.
-    fans: Option<[Cross; 3]>,
+    fans: [Cross; 3],
 }
 
 impl TriangleFrom {
@@ -100,7 +107,9 @@ impl TriangleFrom {
         let [a, b, c] = corners;
         let normal = Cross::of(sub(b, a), sub(c, a));
         let sp = normal.triple(sub(p, a)).unwrap_or_else(|| orient(a, b, c, p));
-        Self { p, corners, normal, sp, fans: None }
+        let [pa, pb, pc] = [a, b, c].map(|x| sub(x, p));
+        let fans = [Cross::of(pb, pc), Cross::of(pc, pa), Cross::of(pa, pb)];
+        Self { p, corners, normal, sp, fans }
     }
 
     /// The crossing of the segment `p q` with the closed triangle, if any.
@@ -112,21 +121,41 @@ impl TriangleFrom {
     /// `V_a = orient(p, q, b, c)`, `V_b = orient(p, q, c, a)`, `V_c = orient(p, q, a, b)` the
     /// barycentric coordinates are `V_k / ΣV`, and `α = s_p / (s_p - s_q)` with
     /// `s = orient(a, b, c, ·)`.
+    ///
+    /// Where every rounded orientation shows its sign, the test decides without a branch on
+    /// them; else each is replaced by the exact one where needed ([`TriangleFrom::crossing_exact`]),
+    /// which gives the same values wherever the rounded ones show their sign.
     #[inline]
-    pub fn crossing(&mut self, q: [f64; 3]) -> Option<EdgeHit> {
+    pub fn crossing(&self, q: [f64; 3]) -> Option<EdgeHit> {
+        let (a, p, sp) = (self.corners[0], self.p, self.sp);
+        let d = sub(q, p);
+        let (sq, certain_q) = self.normal.triple_rounded(sub(q, a));
+        let [(va, ca), (vb, cb), (vc, cc)] = self.fans.map(|f| f.triple_rounded(d));
+        if !(certain_q & ca & cb & cc) {
+            return self.crossing_exact(q);
+        }
+        // `sq`, `va`, `vb`, `vc` are nonzero with exact signs; `sp` may be zero.
+        let same_side = (sp != 0.0) & ((sp > 0.0) == (sq > 0.0));
+        let positive = u8::from(va > 0.0) + u8::from(vb > 0.0) + u8::from(vc > 0.0);
+        if same_side | (positive % 3 != 0) {
+            return None;
+        }
+        Some(Self::hit(sp, sq, [va, vb, vc]))
+    }
+
+    /// [`TriangleFrom::crossing`] with each orientation exact where its rounded value cannot
+    /// show its sign.
+    #[inline(never)]
+    fn crossing_exact(&self, q: [f64; 3]) -> Option<EdgeHit> {
         let ([a, b, c], p, sp) = (self.corners, self.p, self.sp);
         let sq = self.normal.triple(sub(q, a)).unwrap_or_else(|| orient(a, b, c, q));
         if (sp == 0.0 && sq == 0.0) || (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
             return None;
         }
-        let fans = self.fans.get_or_insert_with(|| {
-            let [a, b, c] = [a, b, c].map(|x| sub(x, p));
-            [Cross::of(b, c), Cross::of(c, a), Cross::of(a, b)]
-        });
         // orient(p, q, x, y) = (q - p) · ((x - p) × (y - p)).
         let d = sub(q, p);
         let volume = |k: usize, x: [f64; 3], y: [f64; 3]| {
-            fans[k].triple(d).unwrap_or_else(|| orient(p, q, x, y))
+            self.fans[k].triple(d).unwrap_or_else(|| orient(p, q, x, y))
         };
         // The line misses the closed triangle when two of the volumes take opposite signs: the
         // third is computed only when the first two do not.
@@ -139,12 +168,17 @@ impl TriangleFrom {
         if opposite(va, vc) || opposite(vb, vc) {
             return None;
         }
-        let v = [va, vb, vc];
-        // Not coplanar, so the line meets the plane in one point and the volumes share one sign.
+        Some(Self::hit(sp, sq, [va, vb, vc]))
+    }
+
+    /// The crossing from the orientations of its ends and its volumes, which share one sign (not
+    /// coplanar: the line meets the plane in one point).
+    #[inline]
+    fn hit(sp: f64, sq: f64, v: [f64; 3]) -> EdgeHit {
         let sum = v[0] + v[1] + v[2];
         let bary = [v[0] / sum, v[1] / sum, v[2] / sum];
         let alpha = (sp / (sp - sq)).clamp(0.0, 1.0);
-        Some(EdgeHit { alpha, bary })
+        EdgeHit { alpha, bary }
     }
 }
 
@@ -448,7 +482,7 @@ mod tests {
         let (mut hits, mut cases) = (0, 0);
         for _ in 0..400 {
             let tri: [[f64; 3]; 3] = [(); 3].map(|_| [unit(), unit(), 0.3 * unit()]);
-            let mut from = TriangleFrom::new([0.4, 0.45, 1.0], tri);
+            let from = TriangleFrom::new([0.4, 0.45, 1.0], tri);
             for k in 0..24 {
                 let (s, w) = (unit(), unit());
                 // A point of the triangle's boundary (edge k % 3 at s, or a corner), or inside.
