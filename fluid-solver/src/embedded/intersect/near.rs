@@ -9,9 +9,10 @@
 //! near nor occluded nor swept, and an edge is cut (crossed, or with an occluded end) only if the
 //! reach boxes of both its ends meet a triangle box: each pass over [`Near`] gives
 //! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
-//! ([`NodeBoxes`], built once with the mesh) gives the nodes whose reach box meets the box around
-//! the whole surface, and each of those queries the surface's tree from its root
-//! ([`pairs_by_node`]): in parallel, node by node, so the pairs come out grouped by node.
+//! ([`NodeBoxes`], built once with the mesh) is queried with each triangle box, in parallel, and
+//! the pairs found are regrouped by node by counting ([`pairs_by_node`]): the reach boxes are all
+//! of a size, so each query costs about what it finds, with no query from the nodes inside a
+//! closed surface that meet none.
 //!
 //! Those queries meet every pair of a node and a triangle whose boxes overlap, and [`Near`]
 //! keeps them, grouped by node: each box a pass searches around node `i` (an edge of `i`, its
@@ -215,7 +216,7 @@ impl Near {
     /// from pairs kept over several steps.
     pub fn find(mesh: &Mesh, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
-        let (listed, offsets, triangles) = pairs_by_node(boxes, bvh);
+        let (listed, offsets, triangles) = pairs_by_node(boxes, bvh.len(), |t| bvh.triangle_box(t));
         let rho = boxes.rho;
         let chunks: Vec<Lists> = par_node_chunks(&listed, |run| {
             let mut lists = Lists::default();
@@ -347,38 +348,63 @@ pub(super) fn par_node_chunks<T: Send>(
     nodes.par_chunks(CHUNK).map(run).collect()
 }
 
-/// The pairs of a reach box of `boxes` and an item box of `tree` that overlap, grouped by node:
-/// the nodes with any (ascending), and per node of the mesh the offsets of its items in the
-/// second list (each node's ascending). Each reach box inside the box around the whole `tree` is
-/// queried from the tree's root, by runs of nodes in parallel: a pass over the surface's part of
-/// the mesh, with no traversal of the node hierarchy below that box and no regrouping.
-pub(super) fn pairs_by_node(boxes: &NodeBoxes, tree: &Bvh) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+/// The pairs of a reach box of `boxes` and one of the `n_items` item boxes (`box_of`) that
+/// overlap, grouped by node: the nodes with any (ascending), and per node of the mesh the offsets
+/// of its items in the second list (each node's ascending). Each item box queries the hierarchy
+/// of reach boxes, by runs of items in parallel (a query costs about what it finds: the reach
+/// boxes are all of a size), and the pairs are regrouped by node by counting, in item order.
+pub(super) fn pairs_by_node(
+    boxes: &NodeBoxes,
+    n_items: usize,
+    box_of: impl Fn(usize) -> ([f64; 3], [f64; 3]) + Sync,
+) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+    use rayon::prelude::*;
     let n = boxes.len();
-    let (root_lo, root_hi) = tree.root_box();
-    let mut candidates = Vec::new();
-    if !tree.is_empty() {
-        boxes.tree.for_each_overlap(&root_lo, &root_hi, |i| candidates.push(i));
-    }
-    candidates.sort_unstable();
-    let chunks: Vec<(Vec<u32>, Vec<u32>, Vec<u32>)> = par_node_chunks(&candidates, |nodes| {
-        let (mut listed, mut counts, mut items) = (Vec::new(), Vec::new(), Vec::new());
-        for &i in nodes {
-            let start = items.len();
-            let (lo, hi) = boxes.tree.triangle_box(i as usize);
-            tree.for_each_overlap(&lo, &hi, |r| items.push(r));
-            if items.len() > start {
-                items[start..].sort_unstable();
-                listed.push(i);
-                counts.push((items.len() - start) as u32);
+    // Per run of items: the nodes each item box meets, and how many.
+    let found: Vec<(Vec<u32>, Vec<u32>)> = (0..n_items.div_ceil(ITEMS))
+        .into_par_iter()
+        .map(|c| {
+            let (mut nodes, mut counts) = (Vec::new(), Vec::new());
+            for r in c * ITEMS..((c + 1) * ITEMS).min(n_items) {
+                let start = nodes.len();
+                let (lo, hi) = box_of(r);
+                boxes.tree.for_each_overlap(&lo, &hi, |i| nodes.push(i));
+                counts.push((nodes.len() - start) as u32);
             }
+            (nodes, counts)
+        })
+        .collect();
+    let mut offsets = vec![0u32; n + 1];
+    for (nodes, _) in &found {
+        for &i in nodes {
+            offsets[i as usize + 1] += 1;
         }
-        (listed, counts, items)
-    });
-    let runs: Vec<_> = chunks.iter().map(|c| (&c.0[..], &c.1[..])).collect();
-    let (nodes, offsets) = join_offsets(n, &candidates, &runs);
-    let kept = concat(&chunks.iter().map(|c| &c.2[..]).collect::<Vec<_>>());
-    (nodes, offsets, kept)
+    }
+    let listed: Vec<u32> = (0..n as u32).filter(|&i| offsets[i as usize + 1] > 0).collect();
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    // Items in ascending order, so each node's come out ascending.
+    let mut next = offsets.clone();
+    let mut kept = vec![0u32; offsets[n] as usize];
+    let mut r = 0u32;
+    for c in 0..found.len() {
+        let (nodes, counts) = &found[c];
+        let mut at = 0;
+        for &count in counts {
+            for &i in &nodes[at..at + count as usize] {
+                kept[next[i as usize] as usize] = r;
+                next[i as usize] += 1;
+            }
+            at += count as usize;
+            r += 1;
+        }
+    }
+    (listed, offsets, kept)
 }
+
+/// Item boxes per parallel task of [`pairs_by_node`].
+const ITEMS: usize = 256;
 
 /// The per-node offsets of lists written by runs of the ascending `candidates`
 /// ([`par_node_chunks`]; run `c` listed the nodes `runs[c].0` with `runs[c].1` items each): the

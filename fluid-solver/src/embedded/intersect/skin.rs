@@ -108,8 +108,9 @@ impl NearSkin {
         };
         self.triangles = bvh.len();
         self.topology_version = bvh.topology_version;
-        let widened = Bvh::over_boxes(self.lo.clone(), self.hi.clone());
-        (self.kept_nodes, self.offsets, self.kept) = pairs_by_node(boxes, &widened);
+        let (lo, hi) = (&self.lo, &self.hi);
+        (self.kept_nodes, self.offsets, self.kept) =
+            pairs_by_node(boxes, lo.len(), |r| (lo[r], hi[r]));
         self.rebuilds += 1;
     }
 
