@@ -2,8 +2,8 @@
 //! node's recorded triangles once for several edges.
 //!
 //! Each triangle recorded for node `i` keeps the halves of `i`'s reach box its box reaches
-//! ([`super::near::Split::halves`]), and an edge `[i, j]` needs a triangle box reaching the halves
-//! its own box lies in ([`super::near::Split::needed`]). A table over the 64 sets of halves gives,
+//! ([`super::halves::Split::halves`]), and an edge `[i, j]` needs a triangle box reaching the halves
+//! its own box lies in ([`super::halves::Split::needed`]). A table over the 64 sets of halves gives,
 //! for each set, the edges of a group whose needed halves it holds, so one pass over the list
 //! meets every triangle with just the edges it may overlap: the triangles
 //! [`Near::for_each_overlap`] gives each edge, each tested against the edge's box and then by

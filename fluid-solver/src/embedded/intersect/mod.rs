@@ -13,6 +13,7 @@
 mod closest;
 pub mod collision;
 mod crossings;
+mod halves;
 pub mod near;
 pub mod projection;
 mod pseudo_normals;

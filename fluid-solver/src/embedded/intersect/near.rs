@@ -28,6 +28,7 @@
 //! a pass first tests those six bits and then the box itself: the same triangles, from a scan
 //! that skips most of the list without reading the triangle boxes.
 
+pub(super) use super::halves::Split;
 use super::OCCLUSION;
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
@@ -82,45 +83,6 @@ impl NodeBoxes {
     }
 }
 
-/// A node's position `p` with the planes that split its reach box into halves along each axis,
-/// widened by `rho`: `p + rho` and `p - rho`.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Split {
-    up: [f64; 3],
-    down: [f64; 3],
-}
-
-impl Split {
-    #[inline]
-    pub fn new(p: &[f64; 3], rho: f64) -> Split {
-        Split { up: p.map(|v| v + rho), down: p.map(|v| v - rho) }
-    }
-
-    /// The halves the box `[lo, hi]` reaches: bit `2d` the lower (`lo[d] <= p[d] + rho`), bit
-    /// `2d + 1` the upper (`hi[d] >= p[d] - rho`).
-    #[inline]
-    pub fn halves(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
-        let mut bits = 0;
-        for d in 0..3 {
-            bits |= u8::from(lo[d] <= self.up[d]) << (2 * d);
-            bits |= u8::from(hi[d] >= self.down[d]) << (2 * d + 1);
-        }
-        bits
-    }
-
-    /// The halves every box overlapping `[lo, hi]` reaches: the lower along `d` when
-    /// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho`.
-    #[inline]
-    pub fn needed(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
-        let mut bits = 0;
-        for d in 0..3 {
-            bits |= u8::from(hi[d] <= self.up[d]) << (2 * d);
-            bits |= u8::from(lo[d] >= self.down[d]) << (2 * d + 1);
-        }
-        bits
-    }
-}
-
 /// The mesh nodes whose reach box meets a triangle box, ascending (their edges: [`Near::edges`]);
 /// with, from [`Near::find`], the triangles whose box meets each node's reach box and the halves
 /// of it each reaches.
@@ -172,12 +134,14 @@ impl Lists {
         self.triangles.resize(start + candidates.len(), 0);
         self.halves.resize(start + candidates.len(), 0);
         let (triangles, halves) = (&mut self.triangles[start..], &mut self.halves[start..]);
+        let filter = split.filter(lo, hi);
         let mut len = 0;
         for t in candidates {
             let (a, b) = box_of(t as usize);
+            let (h, meets) = filter.test(&a, &b);
             triangles[len] = t;
-            halves[len] = split.halves(&a, &b);
-            len += usize::from(overlaps(lo, hi, &a, &b));
+            halves[len] = h;
+            len += usize::from(meets);
         }
         self.triangles.truncate(start + len);
         self.halves.truncate(start + len);
