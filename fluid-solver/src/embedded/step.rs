@@ -165,6 +165,7 @@ impl EmbeddedStep {
         let mut changed: Vec<u32> = (tracker.active.par_chunks(UPDATE_CHUNK))
             .zip(self.active.par_chunks(UPDATE_CHUNK))
             .enumerate()
+            .filter(|(_, (now, before))| now != before)
             .flat_map_iter(|(c, (now, before))| {
                 let first = c * UPDATE_CHUNK;
                 let moved = now.iter().zip(before).enumerate().filter(|(_, (n, b))| n != b);
@@ -221,8 +222,33 @@ impl EmbeddedStep {
 }
 
 /// The entries of `old` whose edge is not in `looked`, merged with `now` (edges of `looked`):
-/// all ascending by edge.
+/// all ascending by edge. In parallel over ranges of edges, one from every [`UPDATE_CHUNK`]-th
+/// entry of `old`, each merged in one pass.
 fn replace_sorted(old: &[SpecialEdge], looked: &[u32], now: &[SpecialEdge]) -> Vec<SpecialEdge> {
+    let inner = (UPDATE_CHUNK..old.len()).step_by(UPDATE_CHUNK).map(|k| u64::from(old[k].edge));
+    let bounds: Vec<u64> = std::iter::once(0).chain(inner).chain([u64::MAX]).collect();
+    let parts: Vec<Vec<SpecialEdge>> = bounds
+        .par_windows(2)
+        .map(|r| {
+            let r = [r[0], r[1]];
+            merge_replacing(
+                within(old, |s| s.edge, r),
+                within(looked, |&e| e, r),
+                within(now, |s| s.edge, r),
+            )
+        })
+        .collect();
+    parts.concat()
+}
+
+/// The entries of `items` (ascending by `edge`) whose edge lies in `[lo, hi)`.
+fn within<T>(items: &[T], edge: impl Fn(&T) -> u32, [lo, hi]: [u64; 2]) -> &[T] {
+    let below = |x: u64| items.partition_point(|t| u64::from(edge(t)) < x);
+    &items[below(lo)..below(hi)]
+}
+
+/// [`replace_sorted`] in one pass.
+fn merge_replacing(old: &[SpecialEdge], looked: &[u32], now: &[SpecialEdge]) -> Vec<SpecialEdge> {
     let mut out = Vec::with_capacity(old.len() + now.len());
     let (mut looked, mut now) = (looked.iter().peekable(), now.iter().peekable());
     for s in old {
@@ -419,6 +445,40 @@ mod tests {
     use crate::mesh::boxmesh::FACE_NAMES;
     use crate::semidiscretization::Numerics;
     use interface_protocol::case::Tracking;
+
+    /// The parallel replacement of the looked-at edges equals a plain one (kept entries not
+    /// looked at, then the new ones, sorted) on lists spanning many ranges.
+    #[test]
+    fn replacing_looked_at_edges_by_ranges_is_a_plain_merge() {
+        let mut state = 99u64;
+        let mut next = |m: u64| {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 33) % m
+        };
+        let kinds = [SpecialKind::Dead, SpecialKind::Frozen, SpecialKind::Cut];
+        for _ in 0..20 {
+            let n = 1 + next(3000) as u32;
+            let mut old = Vec::new();
+            let (mut looked, mut now) = (Vec::new(), Vec::new());
+            for e in 0..n {
+                if next(3) == 0 {
+                    old.push(SpecialEdge { edge: e, kind: kinds[next(3) as usize] });
+                }
+                if next(5) == 0 {
+                    looked.push(e);
+                    if next(2) == 0 {
+                        now.push(SpecialEdge { edge: e, kind: kinds[next(3) as usize] });
+                    }
+                }
+            }
+            let mut want: Vec<SpecialEdge> =
+                old.iter().filter(|s| looked.binary_search(&s.edge).is_err()).copied().collect();
+            want.extend(&now);
+            want.sort_by_key(|s| s.edge);
+            assert!(old.len() > 2 * UPDATE_CHUNK || n < 600, "{} entries", old.len());
+            assert_eq!(replace_sorted(&old, &looked, &now), want);
+        }
+    }
 
     /// Bitwise equality of two step views: `{:?}` prints every f64 exactly (shortest round trip,
     /// with the sign of zero).
