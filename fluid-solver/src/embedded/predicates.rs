@@ -97,8 +97,9 @@ pub struct TriangleFrom {
     normal: Cross,
     /// `orient(a, b, c, p)`.
     sp: f64,
-    /// `(b - p) × (c - p)`, `(c - p) × (a - p)`, `(a - p) × (b - p)`.
-    fans: [Cross; 3],
+    /// `(b - p) × (c - p)`, `(c - p) × (a - p)`, `(a - p) × (b - p)`, made at the first edge
+    /// whose ends are not on one side of the plane.
+    fans: Option<[Cross; 3]>,
 }
 
 impl TriangleFrom {
@@ -107,9 +108,7 @@ impl TriangleFrom {
         let [a, b, c] = corners;
         let normal = Cross::of(sub(b, a), sub(c, a));
         let sp = normal.triple(sub(p, a)).unwrap_or_else(|| orient(a, b, c, p));
-        let [pa, pb, pc] = [a, b, c].map(|x| sub(x, p));
-        let fans = [Cross::of(pb, pc), Cross::of(pc, pa), Cross::of(pa, pb)];
-        Self { p, corners, normal, sp, fans }
+        Self { p, corners, normal, sp, fans: None }
     }
 
     /// The crossing of the segment `p q` with the closed triangle, if any.
@@ -126,27 +125,40 @@ impl TriangleFrom {
     /// them; else each is replaced by the exact one where needed ([`TriangleFrom::crossing_exact`]),
     /// which gives the same values wherever the rounded ones show their sign.
     #[inline]
-    pub fn crossing(&self, q: [f64; 3]) -> Option<EdgeHit> {
+    pub fn crossing(&mut self, q: [f64; 3]) -> Option<EdgeHit> {
         let (a, p, sp) = (self.corners[0], self.p, self.sp);
-        let d = sub(q, p);
         let (sq, certain_q) = self.normal.triple_rounded(sub(q, a));
-        let [(va, ca), (vb, cb), (vc, cc)] = self.fans.map(|f| f.triple_rounded(d));
+        // `sq` is nonzero with an exact sign when certain; `sp` may be zero.
+        if certain_q & (sp != 0.0) & ((sp > 0.0) == (sq > 0.0)) {
+            return None;
+        }
+        let d = sub(q, p);
+        let [(va, ca), (vb, cb), (vc, cc)] = self.fans().map(|f| f.triple_rounded(d));
         if !(certain_q & ca & cb & cc) {
             return self.crossing_exact(q);
         }
-        // `sq`, `va`, `vb`, `vc` are nonzero with exact signs; `sp` may be zero.
-        let same_side = (sp != 0.0) & ((sp > 0.0) == (sq > 0.0));
+        // `va`, `vb`, `vc` are nonzero with exact signs.
         let positive = u8::from(va > 0.0) + u8::from(vb > 0.0) + u8::from(vc > 0.0);
-        if same_side | (positive % 3 != 0) {
+        if positive % 3 != 0 {
             return None;
         }
         Some(Self::hit(sp, sq, [va, vb, vc]))
     }
 
+    /// The cross products of the corners seen from `p`.
+    #[inline]
+    fn fans(&mut self) -> [Cross; 3] {
+        let (p, corners) = (self.p, self.corners);
+        *self.fans.get_or_insert_with(|| {
+            let [pa, pb, pc] = corners.map(|x| sub(x, p));
+            [Cross::of(pb, pc), Cross::of(pc, pa), Cross::of(pa, pb)]
+        })
+    }
+
     /// [`TriangleFrom::crossing`] with each orientation exact where its rounded value cannot
     /// show its sign.
     #[inline(never)]
-    fn crossing_exact(&self, q: [f64; 3]) -> Option<EdgeHit> {
+    fn crossing_exact(&mut self, q: [f64; 3]) -> Option<EdgeHit> {
         let ([a, b, c], p, sp) = (self.corners, self.p, self.sp);
         let sq = self.normal.triple(sub(q, a)).unwrap_or_else(|| orient(a, b, c, q));
         if (sp == 0.0 && sq == 0.0) || (sp > 0.0 && sq > 0.0) || (sp < 0.0 && sq < 0.0) {
@@ -154,8 +166,9 @@ impl TriangleFrom {
         }
         // orient(p, q, x, y) = (q - p) · ((x - p) × (y - p)).
         let d = sub(q, p);
+        let fans = self.fans();
         let volume = |k: usize, x: [f64; 3], y: [f64; 3]| {
-            self.fans[k].triple(d).unwrap_or_else(|| orient(p, q, x, y))
+            fans[k].triple(d).unwrap_or_else(|| orient(p, q, x, y))
         };
         // The line misses the closed triangle when two of the volumes take opposite signs: the
         // third is computed only when the first two do not.
@@ -482,7 +495,7 @@ mod tests {
         let (mut hits, mut cases) = (0, 0);
         for _ in 0..400 {
             let tri: [[f64; 3]; 3] = [(); 3].map(|_| [unit(), unit(), 0.3 * unit()]);
-            let from = TriangleFrom::new([0.4, 0.45, 1.0], tri);
+            let mut from = TriangleFrom::new([0.4, 0.45, 1.0], tri);
             for k in 0..24 {
                 let (s, w) = (unit(), unit());
                 // A point of the triangle's boundary (edge k % 3 at s, or a corner), or inside.

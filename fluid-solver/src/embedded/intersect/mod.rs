@@ -180,8 +180,8 @@ impl SurfaceAt<'_> {
         let hi = [0, 1, 2].map(|d| p[d].max(q[d]));
         let mut best = None;
         near.for_each_overlap(self.bvh, i, &p, &lo, &hi, |t| {
-            let triangle = TriangleFrom::new(p, self.corners(t));
-            self.offer_crossing(q, t, &triangle, crack_aware, &mut best);
+            let mut triangle = TriangleFrom::new(p, self.corners(t));
+            self.offer_crossing(q, t, &mut triangle, crack_aware, &mut best);
         });
         best
     }
@@ -194,7 +194,7 @@ impl SurfaceAt<'_> {
         &self,
         q: [f64; 3],
         t: u32,
-        triangle: &TriangleFrom,
+        triangle: &mut TriangleFrom,
         crack_aware: bool,
         best: &mut Option<Crossing>,
     ) {
