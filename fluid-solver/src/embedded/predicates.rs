@@ -121,9 +121,10 @@ impl TriangleFrom {
     /// barycentric coordinates are `V_k / ΣV`, and `α = s_p / (s_p - s_q)` with
     /// `s = orient(a, b, c, ·)`.
     ///
-    /// Where every rounded orientation shows its sign, the test decides without a branch on
-    /// them; else each is replaced by the exact one where needed ([`TriangleFrom::crossing_exact`]),
-    /// which gives the same values wherever the rounded ones show their sign.
+    /// The side of `q` first (an edge on one side needs no volume), then the three volumes
+    /// together, decided from their rounded values where those show their signs; else each is
+    /// replaced by the exact one where needed ([`TriangleFrom::crossing_exact`]), which gives the
+    /// same values wherever the rounded ones show their sign.
     #[inline]
     pub fn crossing(&mut self, q: [f64; 3]) -> Option<EdgeHit> {
         let (a, p, sp) = (self.corners[0], self.p, self.sp);
