@@ -35,15 +35,11 @@ impl Split {
     }
 
     /// The halves every box overlapping `[lo, hi]` reaches: the lower along `d` when
-    /// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho`.
+    /// `hi[d] <= p[d] + rho`, the upper when `lo[d] >= p[d] - rho` (the halves of the box with
+    /// its corners swapped).
     #[inline]
     pub fn needed(&self, lo: &[f64; 3], hi: &[f64; 3]) -> u8 {
-        let mut bits = 0;
-        for d in 0..3 {
-            bits |= u8::from(hi[d] <= self.up[d]) << d;
-            bits |= u8::from(lo[d] >= self.down[d]) << (3 + d);
-        }
-        bits
+        self.halves(hi, lo)
     }
 
     /// The test of the boxes `[a, b]` against the node's reach box `[lo, hi]`
