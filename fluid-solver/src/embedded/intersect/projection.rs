@@ -68,11 +68,10 @@ fn whole_mesh(
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
     near: &Near,
-) -> (Vec<Decision>, Vec<bool>, Vec<u32>, Intersections) {
+) -> (Vec<Decision>, Vec<bool>, Vec<Ends>, Intersections) {
     let decided = decide(mesh, adjacency, at, near, &near.nodes);
     let inside = flood(mesh, adjacency, &near.nodes, sides(&decided));
-    let differ: Vec<u32> =
-        (0..mesh.n_edges() as u32).filter(|&e| differs(mesh, &inside, e)).collect();
+    let differ = differing(mesh, &inside);
     let cuts = cut_edges(mesh, adjacency, at, near, &differ);
     (decided, inside, differ, cuts)
 }
@@ -93,8 +92,9 @@ fn sides(decided: &[Decision]) -> Vec<Option<bool>> {
 /// takes the one value of the `D` nodes around it: the kept value. A node of `U` is not swept
 /// (a swept node lies in a swept triangle box, so it is near), so on a closed, resolved surface
 /// whose nodes move less than an edge per step (thesis §4.4) its side does not change, and (a)
-/// and (b) hold. They are checked every step, cheaply: an edge where (a) can fail is near (it
-/// touches a node of `D`) or kept as differing from the last step; where one fails the step
+/// and (b) hold. They are checked every step, cheaply: an edge that differs now differed at the
+/// last step (the kept list holds those) or touches a node that changed side, a node of `D`
+/// ([`KeptInside::update_near`]); where one fails the step
 /// takes the whole-mesh flood fill instead ([`KeptInside::full_fills`] counts them). Step 5 then
 /// tests only the differing edges, all of them near.
 ///
@@ -115,7 +115,7 @@ pub struct KeptInside {
     last_x: Vec<[f64; 3]>,
     travelled: f64,
     /// Edges whose ends differ, ascending.
-    differ: Vec<u32>,
+    differ: Vec<Ends>,
     /// Connected part of the mesh of each node, and their number.
     part: Vec<u32>,
     n_parts: usize,
@@ -172,8 +172,7 @@ impl KeptInside {
         if !self.update_near(mesh, adjacency, near, &decided) {
             self.full_fills += 1;
             self.inside = flood(mesh, adjacency, &near.nodes, decided);
-            self.differ =
-                (0..mesh.n_edges() as u32).filter(|&e| differs(mesh, &self.inside, e)).collect();
+            self.differ = differing(mesh, &self.inside);
         }
         cut_edges(mesh, adjacency, at, near, &self.differ)
     }
@@ -224,8 +223,13 @@ impl KeptInside {
             .collect()
     }
 
-    /// Sets the decided near nodes and checks (a) and (b) of the type's docs; on success the
-    /// differing edges are the near ones.
+    /// Sets the decided near nodes and checks (a) and (b) of the type's docs, updating the
+    /// differing edges on success.
+    ///
+    /// The kept list holds every differing edge of the last step (the whole-mesh passes make it
+    /// so, and each step keeps it so), and only decided nodes change side, so an edge differs
+    /// now when it did then and still does, or when it touches a node that changed side. Those
+    /// are all the differing edges, and (a) holds when each has both ends decided.
     fn update_near(
         &mut self,
         mesh: &Mesh,
@@ -234,57 +238,40 @@ impl KeptInside {
         decided: &[Option<bool>],
     ) -> bool {
         let mut reached = vec![false; self.n_parts];
+        let mut is_decided = vec![false; mesh.n_nodes()];
+        let mut changed = Vec::new();
         for (&i, d) in near.nodes.iter().zip(decided) {
+            let i = i as usize;
             if let Some(v) = *d {
-                self.inside[i as usize] = v;
-                reached[self.part[i as usize] as usize] = true;
+                if self.inside[i] != v {
+                    self.inside[i] = v;
+                    changed.push(i);
+                }
+                reached[self.part[i] as usize] = true;
+                is_decided[i] = true;
             }
         }
-        let inside = &self.inside;
-        // Per node: 0 not near, 1 near and undecided, 2 near and decided.
-        let mut state = vec![0u8; mesh.n_nodes()];
-        for (&i, d) in near.nodes.iter().zip(decided) {
-            state[i as usize] = 1 + u8::from(d.is_some());
-        }
-        let decided_at = |i: u32| state[i as usize] == 2;
-        let breaks_a = |&e: &u32| {
-            let [i, j] = mesh.edges[e as usize];
-            differs(mesh, inside, e) && !(decided_at(i) && decided_at(j))
-        };
-        if !reached.iter().all(|r| *r) || self.differ.par_iter().any(breaks_a) {
+        if !reached.iter().all(|r| *r) {
             return false;
         }
-        // Every edge touching a near node, once: from its first end when that end is near. A
-        // differing edge with both ends decided has both ends near, so the kept ones come from
-        // their first ends, node by node in order: ascending.
-        let differ: Vec<Option<Vec<u32>>> = near
-            .nodes
-            .par_chunks(CHUNK)
-            .map(|nodes| {
-                let mut differ = Vec::new();
-                for &v in nodes {
-                    for (u, e) in adjacency.neighbours(mesh, v as usize) {
-                        if (u as u32) < v && state[u] != 0 {
-                            continue;
-                        }
-                        if differs(mesh, inside, e) {
-                            if !(decided_at(v) && decided_at(u as u32)) {
-                                return None;
-                            }
-                            differ.push(e);
-                        }
-                    }
-                }
-                Some(differ)
+        let inside = &self.inside;
+        let mut new: Vec<Ends> = changed
+            .iter()
+            .flat_map(|&v| {
+                adjacency.neighbours(mesh, v).filter(move |&(u, _)| inside[u] != inside[v])
             })
+            .map(|(_, e)| (e, mesh.edges[e as usize]))
             .collect();
-        match differ.into_iter().collect::<Option<Vec<Vec<u32>>>>() {
-            Some(parts) => {
-                self.differ = parts.concat();
-                true
-            }
-            None => false,
+        new.sort_unstable();
+        let still: Vec<Ends> =
+            self.differ.par_iter().copied().filter(|e| differs(inside, e)).collect();
+        let differ = merge_ascending(&still, &new);
+        let both_decided = |(_, ends): &Ends| ends.iter().all(|&i| is_decided[i as usize]);
+        if !differ.par_iter().all(both_decided) {
+            return false;
         }
+        self.differ = differ;
+        true
     }
 
     /// Memory in bytes.
@@ -298,11 +285,38 @@ impl KeptInside {
     }
 }
 
-/// Whether the ends of edge `e` differ in `inside`.
+/// An edge with its ends.
+type Ends = (u32, [u32; 2]);
+
+/// The edges of `mesh` whose ends differ in `inside`, ascending.
+fn differing(mesh: &Mesh, inside: &[bool]) -> Vec<Ends> {
+    let ends = mesh.edges.iter().copied().zip(0..);
+    ends.map(|(ends, e)| (e, ends)).filter(|e| differs(inside, e)).collect()
+}
+
+/// The union of two ascending lists, ascending, each value once.
+fn merge_ascending(a: &[Ends], b: &[Ends]) -> Vec<Ends> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    loop {
+        let next = match (a.get(i), b.get(j)) {
+            (Some(&x), Some(&y)) => x.min(y),
+            (Some(&x), None) => x,
+            (None, Some(&y)) => y,
+            (None, None) => return out,
+        };
+        i += usize::from(a.get(i) == Some(&next));
+        j += usize::from(b.get(j) == Some(&next));
+        if out.last() != Some(&next) {
+            out.push(next);
+        }
+    }
+}
+
+/// Whether the ends of an edge differ in `inside`.
 #[inline]
-fn differs(mesh: &Mesh, inside: &[bool], e: u32) -> bool {
-    let [i, j] = mesh.edges[e as usize];
-    inside[i as usize] != inside[j as usize]
+fn differs(inside: &[bool], (_, [i, j]): &Ends) -> bool {
+    inside[*i as usize] != inside[*j as usize]
 }
 
 /// The connected parts of the mesh through its edges: the part of each node and their number.
@@ -339,19 +353,18 @@ fn cut_edges(
     adjacency: &NodeEdges,
     at: SurfaceAt<'_>,
     near: &Near,
-    differ: &[u32],
+    differ: &[Ends],
 ) -> Intersections {
     let occluded = at.occluded(mesh, &adjacency.h_min, false, near);
-    let first = |e: u32| mesh.edges[e as usize][0];
     let cuts: Vec<CutEdge> = differ
         .par_chunks(CHUNK)
         .flat_map_iter(|chunk| {
             let (mut cuts, mut ends) = (Vec::new(), Vec::new());
             // The edges of one node together: their crossings from one pass over its list.
-            for run in chunk.chunk_by(|&a, &b| first(a) == first(b)) {
+            for run in chunk.chunk_by(|(_, a), (_, b)| a[0] == b[0]) {
                 ends.clear();
-                ends.extend(run.iter().map(|&e| (e as usize, mesh.edges[e as usize][1] as usize)));
-                let i = first(run[0]) as usize;
+                ends.extend(run.iter().map(|&(e, [_, j])| (e as usize, j as usize)));
+                let i = run[0].1[0] as usize;
                 at.for_each_crossing_from::<GROUP>(mesh, near, i, &ends, false, |e, c| {
                     cuts.extend(c.map(|c| c.cut(&at, e)).or_else(|| nearest_to_middle(mesh, at, e)))
                 });
@@ -553,5 +566,17 @@ mod tests {
                 assert_eq!(full[i as usize], *w, "node {i}");
             }
         }
+    }
+
+    /// The merge of the kept and the new differing edges: ascending, each edge once.
+    #[test]
+    fn merged_edge_lists_are_ascending_unions() {
+        let e = |k: u32| (k, [k, k + 1]);
+        let (a, b) = ([e(1), e(4), e(7), e(9)], [e(0), e(4), e(8), e(9), e(12)]);
+        let want = [0, 1, 4, 7, 8, 9, 12].map(e);
+        assert_eq!(merge_ascending(&a, &b), want);
+        assert_eq!(merge_ascending(&b, &a), want);
+        assert_eq!(merge_ascending(&a, &[]), a);
+        assert_eq!(merge_ascending(&[], &b), b);
     }
 }
