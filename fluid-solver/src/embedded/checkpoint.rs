@@ -133,7 +133,7 @@ impl EmbeddedRun {
         if tracker.tracking == Tracking::Projection {
             // Alg. 4.1 keeps its inside from step to step: rebuilt by the whole-mesh passes.
             let at = SurfaceAt::at_end(&tracker.surface, bvh)?;
-            let (kept, cuts) = KeptInside::new(mesh, adjacency, at, &near);
+            let (kept, cuts) = KeptInside::new(mesh, adjacency, &tracker.node_boxes, at, &near);
             (tracker.cuts, tracker.kept_inside) = (cuts, Some(kept));
         } else {
             tracker.cuts =

@@ -80,7 +80,7 @@ impl Tracker {
             }
             Tracking::Projection => {
                 let at = SurfaceAt::at_end(&surface, &bvh)?;
-                let (kept, cuts) = KeptInside::new(mesh, &adjacency, at, &near);
+                let (kept, cuts) = KeptInside::new(mesh, &adjacency, &node_boxes, at, &near);
                 (cuts, Some(kept))
             }
         };
@@ -134,7 +134,7 @@ impl Tracker {
     pub fn cuts_near(&mut self, mesh: &Mesh, near: &Near) -> Result<Intersections, TrackError> {
         let at = SurfaceAt::at_end(&self.surface, &self.bvh)?;
         Ok(match &mut self.kept_inside {
-            Some(kept) => kept.advance(mesh, &self.adjacency, at, near),
+            Some(kept) => kept.advance(mesh, &self.adjacency, &self.node_boxes, at, near),
             None => collision_near(mesh, &self.adjacency, at, near),
         })
     }

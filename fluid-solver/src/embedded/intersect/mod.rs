@@ -20,7 +20,7 @@ mod pseudo_normals;
 pub mod skin;
 
 pub use collision::{collision, collision_near};
-pub use near::{Near, NodeBoxes};
+pub use near::{Near, NodeBoxes, ReachBoxes};
 pub use projection::{projection, projection_inside, projection_near, KeptInside};
 pub use skin::NearSkin;
 

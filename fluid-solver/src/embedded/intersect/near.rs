@@ -56,16 +56,9 @@ pub struct NodeBoxes {
 
 impl NodeBoxes {
     pub fn build(mesh: &Mesh, adjacency: &NodeEdges) -> NodeBoxes {
-        let n = mesh.n_nodes();
-        let radius = |h: f64| Some(OCCLUSION * h).filter(|r| r.is_finite());
-        let rho = adjacency.h_min.iter().filter_map(|&h| radius(h)).fold(0.0, f64::max);
-        let (lo, hi) = (0..n)
-            .map(|i| {
-                let (l, h) = adjacency.node_box(mesh, i);
-                (l.map(|v| v - rho), h.map(|v| v + rho))
-            })
-            .unzip();
-        NodeBoxes { tree: Bvh::over_boxes(lo, hi), rho }
+        let reach = ReachBoxes::computed(mesh, adjacency);
+        let (lo, hi) = (0..mesh.n_nodes()).map(|i| reach.of(i)).unzip();
+        NodeBoxes { tree: Bvh::over_boxes(lo, hi), rho: reach.rho() }
     }
 
     /// Number of nodes.
@@ -80,6 +73,44 @@ impl NodeBoxes {
     /// Memory in bytes.
     pub fn memory_bytes(&self) -> usize {
         self.tree.memory_bytes()
+    }
+}
+
+/// The reach boxes of the nodes of a mesh: read from [`NodeBoxes`], or computed as it computes
+/// them (the same values).
+#[derive(Clone, Copy)]
+pub enum ReachBoxes<'a> {
+    Stored(&'a NodeBoxes),
+    Computed { mesh: &'a Mesh, adjacency: &'a NodeEdges, rho: f64 },
+}
+
+impl<'a> ReachBoxes<'a> {
+    /// The reach boxes of `mesh` computed from its adjacency, widened by the largest occlusion
+    /// radius of a node.
+    pub fn computed(mesh: &'a Mesh, adjacency: &'a NodeEdges) -> ReachBoxes<'a> {
+        let radius = |h: f64| Some(OCCLUSION * h).filter(|r| r.is_finite());
+        let rho = adjacency.h_min.iter().filter_map(|&h| radius(h)).fold(0.0, f64::max);
+        ReachBoxes::Computed { mesh, adjacency, rho }
+    }
+
+    /// The widening `ρ` of every box.
+    pub fn rho(&self) -> f64 {
+        match self {
+            ReachBoxes::Stored(boxes) => boxes.rho,
+            ReachBoxes::Computed { rho, .. } => *rho,
+        }
+    }
+
+    /// The reach box of node `i`.
+    #[inline]
+    pub fn of(&self, i: usize) -> ([f64; 3], [f64; 3]) {
+        match self {
+            ReachBoxes::Stored(boxes) => boxes.tree.triangle_box(i),
+            ReachBoxes::Computed { mesh, adjacency, rho } => {
+                let (lo, hi) = adjacency.node_box(mesh, i);
+                (lo.map(|v| v - rho), hi.map(|v| v + rho))
+            }
+        }
     }
 }
 

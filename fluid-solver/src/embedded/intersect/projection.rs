@@ -1,8 +1,9 @@
 //! Alg. 4.1 (thesis §4.2, projection and flood fill) for closed surfaces whose inside the grid
 //! resolves; the surface is wound so that `(b - a) × (c - a)` points out of the body.
 //!
-//! - Steps 1-3: a node whose box (the node and its neighbours) meets a triangle box is near the
-//!   surface; it is inside when `(x_i - x'_i) · N ≤ 0`, with `x'_i` its closest surface point
+//! - Steps 1-3: a node whose box (the node and its neighbours, widened by `ρ`: its reach box of
+//!   [`super::near`], read from the node hierarchy) meets a triangle box is near the surface
+//!   (the widening, `1e-8` edge lengths, only decides a few more nodes); it is inside when `(x_i - x'_i) · N ≤ 0`, with `x'_i` its closest surface point
 //!   (§4.2.1) and `N` the normal of the feature holding `x'_i`: the face normal inside a face,
 //!   and on an edge or a vertex the angle-weighted pseudo-normal (Bærentzen & Aanæs, IEEE TVCG
 //!   2005; the sum of the two face normals on an edge, the corner-angle-weighted sum on a vertex).
@@ -22,7 +23,7 @@
 use super::closest::Nearest;
 use super::crossings::GROUP;
 use super::pseudo_normals::PseudoNormals;
-use super::{Intersections, Near, SurfaceAt};
+use super::{Intersections, Near, NodeBoxes, ReachBoxes, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::predicates::{closest_point, Closest};
 use crate::embedded::CutEdge;
@@ -48,13 +49,14 @@ pub fn projection_near(
     at: SurfaceAt<'_>,
     near: &Near,
 ) -> Intersections {
-    whole_mesh(mesh, adjacency, at, near).3
+    whole_mesh(mesh, adjacency, ReachBoxes::computed(mesh, adjacency), at, near).3
 }
 
 /// Per node: inside the closed surface (Alg. 4.1 steps 1-4).
 pub fn projection_inside(mesh: &Mesh, adjacency: &NodeEdges, at: SurfaceAt<'_>) -> Vec<bool> {
     let all = Near::all(mesh);
-    flood(mesh, adjacency, &all.nodes, sides(&decide(mesh, adjacency, at, &all, &all.nodes)))
+    let reach = ReachBoxes::computed(mesh, adjacency);
+    flood(mesh, adjacency, &all.nodes, sides(&decide(mesh, reach, at, &all, &all.nodes)))
 }
 
 /// A near node's side (`true`: inside) and its distance to the surface, if decided.
@@ -66,10 +68,11 @@ type Decision = Option<(bool, f64)>;
 fn whole_mesh(
     mesh: &Mesh,
     adjacency: &NodeEdges,
+    reach: ReachBoxes<'_>,
     at: SurfaceAt<'_>,
     near: &Near,
 ) -> (Vec<Decision>, Vec<bool>, Vec<Ends>, Intersections) {
-    let decided = decide(mesh, adjacency, at, near, &near.nodes);
+    let decided = decide(mesh, reach, at, near, &near.nodes);
     let inside = flood(mesh, adjacency, &near.nodes, sides(&decided));
     let differ = differing(mesh, &inside);
     let cuts = cut_edges(mesh, adjacency, at, near, &differ);
@@ -127,14 +130,17 @@ pub struct KeptInside {
 }
 
 impl KeptInside {
-    /// The inside at the first step, by the whole-mesh passes, with the cuts.
+    /// The inside at the first step, by the whole-mesh passes, with the cuts; `boxes` are the
+    /// mesh's reach boxes.
     pub fn new(
         mesh: &Mesh,
         adjacency: &NodeEdges,
+        boxes: &NodeBoxes,
         at: SurfaceAt<'_>,
         near: &Near,
     ) -> (KeptInside, Intersections) {
-        let (decided, inside, differ, cuts) = whole_mesh(mesh, adjacency, at, near);
+        let reach = ReachBoxes::Stored(boxes);
+        let (decided, inside, differ, cuts) = whole_mesh(mesh, adjacency, reach, at, near);
         let mut holds_until = vec![0.0; mesh.n_nodes()];
         let closed = at.surface.open_part.iter().all(Option::is_none);
         for (&i, d) in near.nodes.iter().zip(&decided) {
@@ -165,10 +171,11 @@ impl KeptInside {
         &mut self,
         mesh: &Mesh,
         adjacency: &NodeEdges,
+        boxes: &NodeBoxes,
         at: SurfaceAt<'_>,
         near: &Near,
     ) -> Intersections {
-        let decided = self.decide_moved(mesh, adjacency, at, near);
+        let decided = self.decide_moved(mesh, boxes, at, near);
         if !self.update_near(mesh, adjacency, near, &decided) {
             self.full_fills += 1;
             self.inside = flood(mesh, adjacency, &near.nodes, decided);
@@ -182,7 +189,7 @@ impl KeptInside {
     fn decide_moved(
         &mut self,
         mesh: &Mesh,
-        adjacency: &NodeEdges,
+        boxes: &NodeBoxes,
         at: SurfaceAt<'_>,
         near: &Near,
     ) -> Vec<Option<bool>> {
@@ -202,7 +209,7 @@ impl KeptInside {
             .copied()
             .filter(|&i| self.holds_until[i as usize] <= travelled)
             .collect();
-        let decided = decide(mesh, adjacency, at, near, &redo);
+        let decided = decide(mesh, ReachBoxes::Stored(boxes), at, near, &redo);
         self.redecided += redo.len();
         self.kept += near.nodes.len() - redo.len();
         for (&i, d) in redo.iter().zip(&decided) {
@@ -391,16 +398,15 @@ fn nearest_to_middle(mesh: &Mesh, at: SurfaceAt<'_>, e: usize) -> Option<CutEdge
 }
 
 /// Steps 1-3 at the near nodes `nodes` (ascending, all in `near`): each decided by its closest
-/// point, with its distance to the surface (`None` for a node whose box meets no triangle box:
-/// left to the flood fill).
+/// point, with its distance to the surface (`None` for a node whose reach box meets no triangle
+/// box: left to the flood fill).
 fn decide(
     mesh: &Mesh,
-    adjacency: &NodeEdges,
+    reach: ReachBoxes<'_>,
     at: SurfaceAt<'_>,
     near: &Near,
     nodes: &[u32],
 ) -> Vec<Decision> {
-    debug_assert_eq!(adjacency.h_min.len(), mesh.n_nodes(), "adjacency of another mesh");
     if nodes.is_empty() {
         return Vec::new();
     }
@@ -410,7 +416,7 @@ fn decide(
         .map(|&i| {
             let i = i as usize;
             let p = mesh.coords[i];
-            let (lo, hi) = adjacency.node_box(mesh, i);
+            let (lo, hi) = reach.of(i);
             // The candidate whose box is nearest first, then the others that may beat it.
             let mut nearest = Nearest::new(p);
             let mut first: Option<(f64, u32)> = None;
@@ -559,9 +565,12 @@ mod tests {
             let want: Vec<Option<bool>> =
                 near.nodes.iter().map(|&i| decide_unpruned(&mesh, &adj, at, i as usize)).collect();
             assert!(want.iter().filter(|d| d.is_some()).count() > 100);
-            assert_eq!(sides(&decide(&mesh, &adj, at, &near, &near.nodes)), want);
+            let reach = ReachBoxes::computed(&mesh, &adj);
+            assert_eq!(sides(&decide(&mesh, reach, at, &near, &near.nodes)), want);
+            let stored = ReachBoxes::Stored(&boxes);
+            assert_eq!(sides(&decide(&mesh, stored, at, &near, &near.nodes)), want);
             let all = Near::all(&mesh);
-            let full = sides(&decide(&mesh, &adj, at, &all, &all.nodes));
+            let full = sides(&decide(&mesh, reach, at, &all, &all.nodes));
             for (&i, w) in near.nodes.iter().zip(&want) {
                 assert_eq!(full[i as usize], *w, "node {i}");
             }
