@@ -89,6 +89,9 @@ impl Cross {
 /// Every orientation is a triple product of rounded differences, kept when its error bound
 /// ([`TRIPLE_ERROR`]) shows its sign, else replaced by the exact [`orient`]: signs are exact,
 /// and the values depend only on `p`, `q` and the corners, shared or not.
+///
+/// Making one and testing it are always inlined into the scans over a node's triangles: as
+/// calls, the fresh triangle was stored and read back from memory at each test.
 #[derive(Debug, Clone)]
 pub struct TriangleFrom {
     p: [f64; 3],
@@ -103,7 +106,7 @@ pub struct TriangleFrom {
 }
 
 impl TriangleFrom {
-    #[inline]
+    #[inline(always)]
     pub fn new(p: [f64; 3], corners: [[f64; 3]; 3]) -> Self {
         let [a, b, c] = corners;
         let normal = Cross::of(sub(b, a), sub(c, a));
@@ -125,7 +128,7 @@ impl TriangleFrom {
     /// together, decided from their rounded values where those show their signs; else each is
     /// replaced by the exact one where needed ([`TriangleFrom::crossing_exact`]), which gives the
     /// same values wherever the rounded ones show their sign.
-    #[inline]
+    #[inline(always)]
     pub fn crossing(&mut self, q: [f64; 3]) -> Option<EdgeHit> {
         let (a, p, sp) = (self.corners[0], self.p, self.sp);
         let (sq, certain_q) = self.normal.triple_rounded(sub(q, a));
@@ -147,13 +150,15 @@ impl TriangleFrom {
     }
 
     /// The cross products of the corners seen from `p`.
-    #[inline]
+    #[inline(always)]
     fn fans(&mut self) -> [Cross; 3] {
-        let (p, corners) = (self.p, self.corners);
-        *self.fans.get_or_insert_with(|| {
-            let [pa, pb, pc] = corners.map(|x| sub(x, p));
-            [Cross::of(pb, pc), Cross::of(pc, pa), Cross::of(pa, pb)]
-        })
+        if let Some(fans) = self.fans {
+            return fans;
+        }
+        let [pa, pb, pc] = self.corners.map(|x| sub(x, self.p));
+        let fans = [Cross::of(pb, pc), Cross::of(pc, pa), Cross::of(pa, pb)];
+        self.fans = Some(fans);
+        fans
     }
 
     /// [`TriangleFrom::crossing`] with each orientation exact where its rounded value cannot

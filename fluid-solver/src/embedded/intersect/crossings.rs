@@ -73,8 +73,10 @@ impl SurfaceAt<'_> {
                     hits &= hits - 1;
                     let (j, lo, hi) = group[k];
                     if overlaps(&tlo, &thi, &lo, &hi) {
-                        let triangle =
-                            seen.get_or_insert_with(|| TriangleFrom::new(p, self.corners(t)));
+                        let triangle = match &mut seen {
+                            Some(triangle) => triangle,
+                            None => seen.insert(TriangleFrom::new(p, self.corners(t))),
+                        };
                         let q = mesh.coords[j];
                         self.offer_crossing(q, t, triangle, crack_aware, &mut best[k]);
                     }
