@@ -425,13 +425,16 @@ fn join_offsets(n: usize, candidates: &[u32], runs: &[(&[u32], &[u32])]) -> (Vec
     }
     jobs.into_par_iter().for_each(|(first, mut end, ends, to, nodes, counts)| {
         to.copy_from_slice(nodes);
-        let mut next = nodes.iter().zip(counts).peekable();
-        for (k, slot) in ends.iter_mut().enumerate() {
-            if let Some((_, &c)) = next.next_if(|(&i, _)| i as usize == first + k) {
-                end += c;
-            }
-            *slot = end;
+        // The end of each listed node's items, held over the unlisted nodes up to the next.
+        let mut from = 0;
+        for (&i, &c) in nodes.iter().zip(counts) {
+            let k = i as usize - first;
+            ends[from..k].fill(end);
+            end += c;
+            ends[k] = end;
+            from = k + 1;
         }
+        ends[from..].fill(end);
     });
     (listed, offsets)
 }
