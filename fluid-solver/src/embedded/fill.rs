@@ -33,9 +33,10 @@ pub struct FillError {
 pub fn fill_changed(
     swept: &Swept,
     prim: &[[f64; 5]],
-    same_fluid: impl Fn(usize, usize) -> bool,
+    same_fluid: impl Fn(usize, usize) -> bool + Sync,
     linear: bool,
 ) -> Result<Vec<(u32, [f64; 5])>, FillError> {
+    use rayon::prelude::*;
     let mesh = swept.mesh;
     // The same-side, same-fluid neighbours of `i` that `ring` gives a state for, averaged.
     let average = |i: usize, ring: &dyn Fn(usize) -> Option<[f64; 5]>| -> Option<[f64; 5]> {
@@ -56,9 +57,11 @@ pub fn fill_changed(
         let stencil = swept.sources(j).filter(|&m| same_fluid(j, m));
         linear_at(mesh, prim, j, stencil, mesh.coords[i]).unwrap_or(prim[j])
     };
-    swept
-        .nodes()
-        .map(|i| {
+    // Each node on its own, in parallel; the first error in the order of the changes.
+    let nodes: Vec<usize> = swept.nodes().collect();
+    let filled: Vec<Result<(u32, [f64; 5]), FillError>> = nodes
+        .par_iter()
+        .map(|&i| {
             let first =
                 |j: usize| swept.keeps(j).then(|| if linear { carried(j, i) } else { prim[j] });
             // Second ring for the rest: sources two edges away.
@@ -68,7 +71,8 @@ pub fn fill_changed(
                 FillError { node: i as u32, position: mesh.coords[i], side: swept.sides.side[i] },
             )
         })
-        .collect()
+        .collect();
+    filled.into_iter().collect()
 }
 
 /// `W_j + G_j (x - x_j)` with `G_j` the least-squares gradient of `prim` at `j` over the nodes
