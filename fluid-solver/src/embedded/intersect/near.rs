@@ -4,8 +4,8 @@
 //!
 //! Each node's *reach box* is the box of the node and its neighbours ([`NodeEdges::node_box`]),
 //! widened by the largest occlusion radius `ρ = max OCCLUSION * h_min`. It holds every edge of the
-//! node, the occlusion balls of the node and its neighbours, and its projection box (Alg. 4.1
-//! step 1). So a node whose reach box meets no swept triangle box of the hierarchy is neither
+//! node and the occlusion balls of the node and its neighbours, and it is the node's projection
+//! box (Alg. 4.1 step 1, [`ReachBoxes`]). So a node whose reach box meets no swept triangle box of the hierarchy is neither
 //! near nor occluded nor swept, and an edge is cut (crossed, or with an occluded end) only if the
 //! reach boxes of both its ends meet a triangle box: each pass over [`Near`] gives
 //! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
@@ -302,9 +302,9 @@ impl Near {
     }
 
     /// Calls `visit` with every triangle of `bvh` whose box overlaps `[lo, hi]`, a box inside the
-    /// reach box of node `i` at `p` (the node's edges, its occlusion ball, its projection box):
-    /// from the triangles recorded for `i` that reach the halves the box needs ([`Split::halves`]), else
-    /// (none recorded, [`Near::all`]) by a query from the root. The same triangles either way (a
+    /// reach box of node `i` at `p` (the node's edges, its occlusion ball, the reach box itself):
+    /// from the triangles recorded for `i` that reach the halves the box needs
+    /// ([`Split::halves`]), else (none recorded, [`Near::all`]) by a query from the root. The same triangles either way (a
     /// triangle box meeting `[lo, hi]` meets the reach box), in another order. `bvh` must be the
     /// hierarchy `find` was given, unchanged since.
     #[inline]

@@ -3,12 +3,13 @@
 //!
 //! - Steps 1-3: a node whose box (the node and its neighbours, widened by `ρ`: its reach box of
 //!   [`super::near`], read from the node hierarchy) meets a triangle box is near the surface
-//!   (the widening, `1e-8` edge lengths, only decides a few more nodes); it is inside when `(x_i - x'_i) · N ≤ 0`, with `x'_i` its closest surface point
-//!   (§4.2.1) and `N` the normal of the feature holding `x'_i`: the face normal inside a face,
-//!   and on an edge or a vertex the angle-weighted pseudo-normal (Bærentzen & Aanæs, IEEE TVCG
-//!   2005; the sum of the two face normals on an edge, the corner-angle-weighted sum on a vertex).
-//!   This replaces the case analysis of §4.2.2 (b) and (c) by one rule with the same answer on a
-//!   closed, consistently wound surface.
+//!   (the widening, `1e-8` edge lengths, only decides a few more nodes); it is inside when
+//!   `(x_i - x'_i) · N ≤ 0`, with `x'_i` its closest surface point (§4.2.1) and `N` the normal
+//!   of the feature holding `x'_i`: the face normal inside a face, and on an edge or a vertex
+//!   the angle-weighted pseudo-normal (Bærentzen & Aanæs, IEEE TVCG 2005; the sum of the two
+//!   face normals on an edge, the corner-angle-weighted sum on a vertex). This replaces the case
+//!   analysis of §4.2.2 (b) and (c) by one rule with the same answer on a closed, consistently
+//!   wound surface.
 //! - Step 4: the other nodes take the side of the nearest decided node by a flood fill over the
 //!   adjacency; a part of the mesh with no decided node is outside.
 //! - Step 5: an edge whose ends are on different sides is cut where it crosses the triangles near
