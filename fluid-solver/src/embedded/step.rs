@@ -81,7 +81,7 @@ impl PartialEq for FluxClock {
 const UPDATE_CHUNK: usize = if cfg!(test) { 64 } else { 4096 };
 
 /// The sorted union of two ascending lists, each value once.
-fn union_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
+pub(super) fn union_sorted<T: Ord + Copy>(a: &[T], b: &[T]) -> Vec<T> {
     let mut out = Vec::with_capacity(a.len() + b.len());
     let (mut x, mut y) = (0, 0);
     loop {
@@ -520,7 +520,10 @@ mod tests {
         assert_eq!(union_sorted(&[1, 4, 9], &[0, 4, 4, 10]), vec![0, 1, 4, 9, 10]);
         assert_eq!(union_sorted(&[], &[2, 2, 3]), vec![2, 3]);
         assert_eq!(union_sorted(&[5, 7], &[]), vec![5, 7]);
-        assert!(union_sorted(&[], &[]).is_empty());
+        assert!(union_sorted::<u32>(&[], &[]).is_empty());
+        // Edges with their ends, as Alg. 4.1 keeps them.
+        let (a, b) = ([(1, [1, 2]), (4, [2, 5])], [(0, [0, 3]), (1, [1, 2])]);
+        assert_eq!(union_sorted(&a, &b), vec![(0, [0, 3]), (1, [1, 2]), (4, [2, 5])]);
     }
 
     /// A sphere (Alg. 4.1 and 4.2) and a plane through the slip walls (Alg. 4.2, so the mirror

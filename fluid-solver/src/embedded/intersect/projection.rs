@@ -27,6 +27,7 @@ use super::pseudo_normals::PseudoNormals;
 use super::{Intersections, Near, NodeBoxes, ReachBoxes, SurfaceAt};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::predicates::{closest_point, Closest};
+use crate::embedded::step::union_sorted;
 use crate::embedded::CutEdge;
 use crate::mesh::geometry::{add, dot, norm, scale, sub};
 use crate::mesh::Mesh;
@@ -273,7 +274,7 @@ impl KeptInside {
         new.sort_unstable();
         let still: Vec<Ends> =
             self.differ.par_iter().copied().filter(|e| differs(inside, e)).collect();
-        let differ = merge_ascending(&still, &new);
+        let differ = union_sorted(&still, &new);
         let both_decided = |(_, ends): &Ends| ends.iter().all(|&i| is_decided[i as usize]);
         if !differ.par_iter().all(both_decided) {
             return false;
@@ -300,25 +301,6 @@ type Ends = (u32, [u32; 2]);
 fn differing(mesh: &Mesh, inside: &[bool]) -> Vec<Ends> {
     let ends = mesh.edges.iter().copied().zip(0..);
     ends.map(|(ends, e)| (e, ends)).filter(|e| differs(inside, e)).collect()
-}
-
-/// The union of two ascending lists, ascending, each value once.
-fn merge_ascending(a: &[Ends], b: &[Ends]) -> Vec<Ends> {
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    loop {
-        let next = match (a.get(i), b.get(j)) {
-            (Some(&x), Some(&y)) => x.min(y),
-            (Some(&x), None) => x,
-            (None, Some(&y)) => y,
-            (None, None) => return out,
-        };
-        i += usize::from(a.get(i) == Some(&next));
-        j += usize::from(b.get(j) == Some(&next));
-        if out.last() != Some(&next) {
-            out.push(next);
-        }
-    }
 }
 
 /// Whether the ends of an edge differ in `inside`.
@@ -576,17 +558,5 @@ mod tests {
                 assert_eq!(full[i as usize], *w, "node {i}");
             }
         }
-    }
-
-    /// The merge of the kept and the new differing edges: ascending, each edge once.
-    #[test]
-    fn merged_edge_lists_are_ascending_unions() {
-        let e = |k: u32| (k, [k, k + 1]);
-        let (a, b) = ([e(1), e(4), e(7), e(9)], [e(0), e(4), e(8), e(9), e(12)]);
-        let want = [0, 1, 4, 7, 8, 9, 12].map(e);
-        assert_eq!(merge_ascending(&a, &b), want);
-        assert_eq!(merge_ascending(&b, &a), want);
-        assert_eq!(merge_ascending(&a, &[]), a);
-        assert_eq!(merge_ascending(&[], &b), b);
     }
 }
