@@ -17,6 +17,9 @@ pub(super) struct Split {
 }
 
 impl Split {
+    /// The six halves: what a box holding the node within `rho` reaches.
+    pub const EVERY_HALF: u8 = 0b11_1111;
+
     #[inline]
     pub fn new(p: &[f64; 3], rho: f64) -> Split {
         Split { up: p.map(|v| v + rho), down: p.map(|v| v - rho) }

@@ -261,10 +261,10 @@ impl SurfaceAt<'_> {
     }
 
     /// Occluded nodes (Alg. 4.2 step 3.1): within `OCCLUSION * h_min(i)` of the surface, among
-    /// the nodes of `near` (the others are not).
+    /// the nodes of `near` that can be ([`Near::occlusion_candidates`]; the others are not).
     fn occluded(&self, mesh: &Mesh, h_min: &[f64], crack_aware: bool, near: &Near) -> Vec<bool> {
         use rayon::prelude::*;
-        let nodes = &near.nodes;
+        let nodes = near.occlusion_candidates();
         let hit: Vec<bool> = nodes
             .par_iter()
             .enumerate()
