@@ -199,12 +199,18 @@ impl Surface {
 
 /// The edges of a triangulated surface: each distinct node pair with the triangle sides holding
 /// it, `(triangle, k)` for the side opposite corner `k`; one on a free edge, two on a manifold
-/// edge, more where sheets meet.
+/// edge, more where sheets meet. With them, the triangles around each node.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SurfaceEdges {
     /// Edge `m` is held by `sides[offsets[m]..offsets[m + 1]]`.
     offsets: Vec<u32>,
     sides: Vec<(u32, u8)>,
+    /// Per triangle, the edge of each side.
+    edge_of: Vec<[u32; 3]>,
+    /// The triangles holding node `v` are `around[around_offsets[v]..around_offsets[v + 1]]`,
+    /// ascending, each once.
+    around_offsets: Vec<u32>,
+    around: Vec<u32>,
 }
 
 impl SurfaceEdges {
@@ -219,16 +225,62 @@ impl SurfaceEdges {
         }
         keys.sort_unstable();
         let mut offsets = vec![0];
-        for run in keys.chunk_by(|x, y| x.0 == y.0) {
+        let mut edge_of = vec![[0; 3]; triangles.len()];
+        for (m, run) in keys.chunk_by(|x, y| x.0 == y.0).enumerate() {
             offsets.push(offsets.last().copied().unwrap_or(0) + run.len() as u32);
+            for &(_, t, k) in run {
+                edge_of[t as usize][k as usize] = m as u32;
+            }
         }
         let sides = keys.into_iter().map(|(_, t, k)| (t, k)).collect();
-        SurfaceEdges { offsets, sides }
+        // The triangles around each node by counting, in triangle order.
+        let corners = |tri: &[u32; 3]| {
+            let tri = *tri;
+            (0..3).filter(move |&k| !tri[..k].contains(&tri[k])).map(move |k| tri[k])
+        };
+        let n_nodes = triangles.iter().flatten().max().map_or(0, |&v| v as usize + 1);
+        let mut around_offsets = vec![0u32; n_nodes + 1];
+        for v in triangles.iter().flat_map(corners) {
+            around_offsets[v as usize + 1] += 1;
+        }
+        for v in 0..n_nodes {
+            around_offsets[v + 1] += around_offsets[v];
+        }
+        let mut next = around_offsets.clone();
+        let mut around = vec![0; around_offsets[n_nodes] as usize];
+        for (t, tri) in triangles.iter().enumerate() {
+            for v in corners(tri) {
+                around[next[v as usize] as usize] = t as u32;
+                next[v as usize] += 1;
+            }
+        }
+        SurfaceEdges { offsets, sides, edge_of, around_offsets, around }
     }
 
     /// Each edge's triangle sides.
     pub fn runs(&self) -> impl Iterator<Item = &[(u32, u8)]> {
         self.offsets.windows(2).map(|w| &self.sides[w[0] as usize..w[1] as usize])
+    }
+
+    /// The number of the edge side `k` of triangle `t` lies on (the edges in the order of
+    /// [`SurfaceEdges::runs`]).
+    pub fn edge_of(&self, t: u32, k: u8) -> u32 {
+        self.edge_of[t as usize][k as usize]
+    }
+
+    /// The triangle sides holding edge `m`.
+    pub fn run(&self, m: u32) -> &[(u32, u8)] {
+        let m = m as usize;
+        &self.sides[self.offsets[m] as usize..self.offsets[m + 1] as usize]
+    }
+
+    /// The triangles holding node `v`, ascending (none for a node of no triangle).
+    pub fn around(&self, v: u32) -> &[u32] {
+        let v = v as usize;
+        match (self.around_offsets.get(v), self.around_offsets.get(v + 1)) {
+            (Some(&a), Some(&b)) => &self.around[a as usize..b as usize],
+            _ => &[],
+        }
     }
 
     /// Per triangle (of `n`), its connected part (triangles joined through shared edges, named

@@ -532,6 +532,25 @@ mod tests {
         }
     }
 
+    /// The normals of a few features, from the triangles around them, are bitwise those made
+    /// from the normals of every feature.
+    #[test]
+    fn normals_of_some_features_are_those_of_all() {
+        for s in [sphere([0.5; 3], 0.3, 5), box_surface([0.3, 0.3, 0.4], [0.7, 0.6, 0.8], 2)] {
+            let bvh = Bvh::build(&s, 1e-4);
+            let at = SurfaceAt::at_end(&s, &bvh).unwrap();
+            let n = s.triangles.len() as u32;
+            let features = [Feature::Face, Feature::Edge(1), Feature::Vertex(2), Feature::Edge(0)];
+            let wanted: Vec<(u32, Feature)> =
+                (0..n).step_by(3).zip(features.iter().cycle().copied()).collect();
+            let normals = PseudoNormals::of(at, wanted.iter().copied());
+            for &(t, feature) in &wanted {
+                assert_eq!(normals.at(t, feature), every_normal(at, t, feature), "{t} {feature:?}");
+            }
+            assert!(wanted.len() > 10);
+        }
+    }
+
     /// The pruned steps 1-3 decide every near node as the unpruned search does, over the
     /// recorded triangles and over the whole mesh.
     #[test]

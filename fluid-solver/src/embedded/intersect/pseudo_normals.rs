@@ -5,9 +5,10 @@
 //!
 //! A step decides a few hundred nodes, whose closest points lie on as many features, while the
 //! surface has tens of thousands: [`PseudoNormals::of`] computes the normals of the features
-//! asked for only (the corner angles, one `atan2` each, were most of the cost), each from the
-//! same terms summed in the same order (triangle order on a vertex, the edge's sides in order on
-//! an edge) as the normals of every feature would be: the same values bitwise.
+//! asked for only, from the triangles around them (the surface's edges and the triangles around
+//! each node, [`crate::embedded::surface::SurfaceEdges`]), each from the same terms summed in the
+//! same order (triangle order on a vertex, the edge's sides in order on an edge) as the normals
+//! of every feature would be: the same values bitwise.
 
 use super::SurfaceAt;
 use crate::embedded::predicates::{unit_normal, Feature};
@@ -16,10 +17,10 @@ use crate::mesh::geometry::{add, cross, dot, norm, scale, sub};
 /// The normals of some features of the surface at one set of positions.
 pub(super) struct PseudoNormals<'a> {
     at: SurfaceAt<'a>,
-    /// Face normals of the triangles the features asked for need (zero elsewhere).
-    face: Vec<[f64; 3]>,
-    /// Vertex normals of the vertices asked for (zero elsewhere).
-    vertex: Vec<[f64; 3]>,
+    /// Face normals of the triangles the features asked for need, by triangle, ascending.
+    face: Vec<(u32, [f64; 3])>,
+    /// Vertex normals of the vertices asked for, by node, ascending.
+    vertex: Vec<(u32, [f64; 3])>,
     /// The edge normals asked for, by triangle side `(t, k)` (the edge opposite corner `k`),
     /// ascending.
     edge: Vec<((u32, u8), [f64; 3])>,
@@ -33,57 +34,56 @@ pub(super) fn corner_angle(c: &[[f64; 3]; 3], k: usize) -> f64 {
 }
 
 impl<'a> PseudoNormals<'a> {
-    /// The normals of the features `wanted` (triangle, feature) of the surface `at`.
+    /// The normals of the features `wanted` (triangle, feature) of the surface `at`: the face
+    /// normals of the triangles they touch (through the surface's edges and the triangles
+    /// around each node), summed.
     pub fn of(
         at: SurfaceAt<'a>,
         wanted: impl Iterator<Item = (u32, Feature)>,
     ) -> PseudoNormals<'a> {
-        let tris = &at.surface.triangles;
-        let mut face_wanted = vec![false; tris.len()];
-        let mut vertex_wanted = vec![false; at.x.len()];
-        let mut sides_wanted = Vec::new();
+        let (tris, edges) = (&at.surface.triangles, &at.surface.edges);
+        let (mut faces, mut vertices, mut runs) = (Vec::new(), Vec::new(), Vec::new());
         for (t, feature) in wanted {
             match feature {
-                Feature::Face => face_wanted[t as usize] = true,
-                Feature::Edge(k) => sides_wanted.push((t, k)),
-                Feature::Vertex(k) => vertex_wanted[tris[t as usize][k as usize] as usize] = true,
+                Feature::Face => faces.push(t),
+                Feature::Edge(k) => runs.push(edges.edge_of(t, k)),
+                Feature::Vertex(k) => vertices.push(tris[t as usize][k as usize]),
             }
         }
-        sides_wanted.sort_unstable();
-        sides_wanted.dedup();
-        // The edges holding a wanted side, and the triangles around the wanted vertices.
-        let runs: Vec<&[(u32, u8)]> = at
-            .surface
-            .edges
-            .runs()
-            .filter(|run| run.iter().any(|side| sides_wanted.binary_search(side).is_ok()))
+        for v in [&mut runs, &mut vertices] {
+            v.sort_unstable();
+            v.dedup();
+        }
+        faces.extend(runs.iter().flat_map(|&m| edges.run(m).iter().map(|&(t, _)| t)));
+        faces.extend(vertices.iter().flat_map(|&v| edges.around(v).iter().copied()));
+        faces.sort_unstable();
+        faces.dedup();
+        let face: Vec<(u32, [f64; 3])> = faces
+            .into_iter()
+            .map(|t| {
+                let [a, b, c] = at.corners(t);
+                (t, unit_normal(a, b, c))
+            })
             .collect();
-        for &(t, _) in runs.iter().copied().flatten() {
-            face_wanted[t as usize] = true;
-        }
-        for (t, tri) in tris.iter().enumerate() {
-            if tri.iter().any(|&v| vertex_wanted[v as usize]) {
-                face_wanted[t] = true;
-            }
-        }
-        let mut face = vec![[0.0; 3]; tris.len()];
-        for (t, n) in face.iter_mut().enumerate().filter(|(t, _)| face_wanted[*t]) {
-            let [a, b, c] = at.corners(t as u32);
-            *n = unit_normal(a, b, c);
-        }
-        let mut vertex = vec![[0.0; 3]; at.x.len()];
-        for (t, tri) in tris.iter().enumerate() {
-            for k in 0..3 {
-                let v = tri[k] as usize;
-                if vertex_wanted[v] {
-                    let share = scale(face[t], corner_angle(&at.corners(t as u32), k));
-                    vertex[v] = add(vertex[v], share);
+        let face_of = |t: u32| face[face.partition_point(|&(u, _)| u < t)].1;
+        // Each sum over the triangles in ascending order, corners in order.
+        let vertex = vertices
+            .into_iter()
+            .map(|v| {
+                let mut n = [0.0; 3];
+                for &t in edges.around(v) {
+                    let tri = tris[t as usize];
+                    for k in (0..3).filter(|&k| tri[k] == v) {
+                        n = add(n, scale(face_of(t), corner_angle(&at.corners(t), k)));
+                    }
                 }
-            }
-        }
+                (v, n)
+            })
+            .collect();
         let mut edge = Vec::new();
-        for run in runs {
-            let n = run.iter().fold([0.0; 3], |s, &(t, _)| add(s, face[t as usize]));
+        for m in runs {
+            let run = edges.run(m);
+            let n = run.iter().fold([0.0; 3], |s, &(t, _)| add(s, face_of(t)));
             edge.extend(run.iter().map(|&side| (side, n)));
         }
         edge.sort_unstable_by_key(|&(side, _)| side);
@@ -93,14 +93,17 @@ impl<'a> PseudoNormals<'a> {
     /// The normal of `feature` of triangle `t`, one of those asked for.
     #[inline]
     pub fn at(&self, t: u32, feature: Feature) -> [f64; 3] {
+        let find = |list: &[(u32, [f64; 3])], key: u32| {
+            list.binary_search_by_key(&key, |&(k, _)| k).map_or([0.0; 3], |m| list[m].1)
+        };
         match feature {
-            Feature::Face => self.face[t as usize],
+            Feature::Face => find(&self.face, t),
             Feature::Edge(k) => {
                 let found = self.edge.binary_search_by_key(&(t, k), |&(side, _)| side);
                 found.map_or([0.0; 3], |m| self.edge[m].1)
             }
             Feature::Vertex(k) => {
-                self.vertex[self.at.surface.triangles[t as usize][k as usize] as usize]
+                find(&self.vertex, self.at.surface.triangles[t as usize][k as usize])
             }
         }
     }
