@@ -139,7 +139,8 @@ impl EmbeddedStep {
             true => interface,
             false => InterfaceTreatment::FirstOrder,
         };
-        let (ours, merged, frozen_edges) = special_edges(semi, list);
+        let frozen_edges = frozen_among(&list);
+        let (ours, merged) = special_edges(semi, list);
         EmbeddedStep {
             ours,
             merged,
@@ -154,9 +155,10 @@ impl EmbeddedStep {
     }
 
     /// The step's view after `tracker` moved on: only the edges whose status can have changed
-    /// (cut before or now, or touching a node whose activity changed) are looked at, and the
-    /// gradient is rebuilt only at the ends of those whose status did change
-    /// ([`LsqGradient::remask`]). Bitwise the same as [`EmbeddedStep::new`] on the same scheme.
+    /// (cut before or now but not both, or touching a node whose activity changed; an edge cut
+    /// both times stays a cut, out of the gradient) are looked at, and the gradient is rebuilt
+    /// only at the ends of those whose status did change ([`LsqGradient::remask`]). Bitwise the
+    /// same as [`EmbeddedStep::new`] on the same scheme.
     pub fn update(&mut self, semi: &Semidiscretization, tracker: &Tracker) {
         let mesh = &semi.mesh;
         let material = semi.material();
@@ -174,7 +176,7 @@ impl EmbeddedStep {
             .collect();
         changed.par_sort_unstable();
         // The cut edges before and now are each sorted: two merges.
-        let edges = union_sorted(&union_sorted(&self.cut, &cut), &changed);
+        let edges = union_sorted(&symmetric_difference(&self.cut, &cut), &changed);
         // Each run of edges walks the cut list from its first edge.
         let parts: Vec<(Vec<u32>, Vec<SpecialEdge>)> = edges
             .par_chunks(UPDATE_CHUNK)
@@ -198,8 +200,10 @@ impl EmbeddedStep {
         let now: Vec<SpecialEdge> = parts.iter().flat_map(|p| p.1.iter().copied()).collect();
         self.gradient.remask(mesh, &flipped, |i| tracker.adjacency.edges_of(i));
         // The special edges that were not looked at stay as they were.
-        let list = replace_sorted(self.ours.all(), &edges, &now);
-        (self.ours, self.merged, self.frozen_edges) = special_edges(semi, list);
+        let (list, replaced) = replace_sorted(self.ours.all(), &edges, &now);
+        let frozen = self.frozen_edges - replaced + frozen_among(&now);
+        (self.ours, self.merged) = special_edges(semi, list);
+        self.frozen_edges = frozen;
         self.cut = cut;
         self.active.copy_from_slice(&tracker.active);
     }
@@ -221,47 +225,68 @@ impl EmbeddedStep {
     }
 }
 
-/// The entries of `old` whose edge is not in `looked`, merged with `now` (edges of `looked`):
-/// all ascending by edge. In parallel over ranges of edges, one from every [`UPDATE_CHUNK`]-th
-/// entry of `old`, each merged in one pass.
-fn replace_sorted(old: &[SpecialEdge], looked: &[u32], now: &[SpecialEdge]) -> Vec<SpecialEdge> {
-    let inner = (UPDATE_CHUNK..old.len()).step_by(UPDATE_CHUNK).map(|k| u64::from(old[k].edge));
-    let bounds: Vec<u64> = std::iter::once(0).chain(inner).chain([u64::MAX]).collect();
-    let parts: Vec<Vec<SpecialEdge>> = bounds
-        .par_windows(2)
-        .map(|r| {
-            let r = [r[0], r[1]];
-            merge_replacing(
-                within(old, |s| s.edge, r),
-                within(looked, |&e| e, r),
-                within(now, |s| s.edge, r),
-            )
-        })
-        .collect();
-    parts.concat()
-}
-
-/// The entries of `items` (ascending by `edge`) whose edge lies in `[lo, hi)`.
-fn within<T>(items: &[T], edge: impl Fn(&T) -> u32, [lo, hi]: [u64; 2]) -> &[T] {
-    let below = |x: u64| items.partition_point(|t| u64::from(edge(t)) < x);
-    &items[below(lo)..below(hi)]
-}
-
-/// [`replace_sorted`] in one pass.
-fn merge_replacing(old: &[SpecialEdge], looked: &[u32], now: &[SpecialEdge]) -> Vec<SpecialEdge> {
-    let mut out = Vec::with_capacity(old.len() + now.len());
-    let (mut looked, mut now) = (looked.iter().peekable(), now.iter().peekable());
-    for s in old {
-        while let Some(n) = now.next_if(|n| n.edge < s.edge) {
-            out.push(*n);
-        }
-        while looked.next_if(|&&e| e < s.edge).is_some() {}
-        if looked.peek() != Some(&&s.edge) {
-            out.push(*s);
+/// The values in exactly one of two ascending lists (each value at most once in each),
+/// ascending.
+fn symmetric_difference(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let mut out = Vec::new();
+    let (mut a, mut b) = (a.iter().peekable(), b.iter().peekable());
+    loop {
+        match (a.peek(), b.peek()) {
+            (Some(&&x), Some(&&y)) if x == y => {
+                a.next();
+                b.next();
+            }
+            (Some(&&x), Some(&&y)) if x < y => out.extend(a.next()),
+            (Some(_), Some(_)) => out.extend(b.next()),
+            (Some(_), None) => out.extend(a.next()),
+            (None, Some(_)) => out.extend(b.next()),
+            (None, None) => return out,
         }
     }
-    out.extend(now);
-    out
+}
+
+/// The entries of `old` whose edge is not in `looked`, merged with `now` (entries of edges of
+/// `looked`): all ascending by edge, and how many frozen entries of `old` were replaced. The
+/// entries between two looked-at edges are copied as one stretch, found by galloping from the
+/// last one, so a few looked-at edges cost little more than one copy of `old`.
+fn replace_sorted(
+    old: &[SpecialEdge],
+    looked: &[u32],
+    now: &[SpecialEdge],
+) -> (Vec<SpecialEdge>, usize) {
+    let mut out = Vec::with_capacity(old.len() + now.len());
+    let (mut from, mut replaced) = (0, 0);
+    let mut now = now.iter().peekable();
+    for &e in looked {
+        let k = from + gallop(&old[from..], e);
+        out.extend_from_slice(&old[from..k]);
+        from = k;
+        if let Some(s) = old.get(k).filter(|s| s.edge == e) {
+            replaced += usize::from(s.kind == SpecialKind::Frozen);
+            from += 1;
+        }
+        out.extend(now.next_if(|n| n.edge == e));
+    }
+    debug_assert!(now.next().is_none(), "a new entry of an edge not looked at");
+    out.extend_from_slice(&old[from..]);
+    (out, replaced)
+}
+
+/// The number of leading entries of `items` (ascending by edge) whose edge is below `e`: steps
+/// doubling from the front, then a binary search within the last.
+fn gallop(items: &[SpecialEdge], e: u32) -> usize {
+    let mut end = 1;
+    while end < items.len() && items[end - 1].edge < e {
+        end *= 2;
+    }
+    // Every entry before `end / 2` is below `e`, and none from `end` on.
+    let start = end / 2;
+    start + items[start..end.min(items.len())].partition_point(|s| s.edge < e)
+}
+
+/// The number of frozen entries of `list`.
+fn frozen_among(list: &[SpecialEdge]) -> usize {
+    list.iter().filter(|s| s.kind == SpecialKind::Frozen).count()
 }
 
 /// What one edge is in a step.
@@ -288,17 +313,16 @@ impl EdgeKind {
 }
 
 /// The dead, frozen and cut edges of `list` (ascending) per block, merged with the scheme's
-/// special edges when it has any, and the number of frozen edges.
+/// special edges when it has any.
 fn special_edges(
     semi: &Semidiscretization,
     list: Vec<SpecialEdge>,
-) -> (SpecialEdges, Option<SpecialEdges>, usize) {
-    let frozen = list.iter().filter(|s| s.kind == SpecialKind::Frozen).count();
+) -> (SpecialEdges, Option<SpecialEdges>) {
     let blocks = &semi.mesh.blocks;
     let ours = SpecialEdges::from_sorted(blocks, list);
     let scheme = semi.special_edges();
     let merged = (!scheme.is_empty()).then(|| scheme.merge(&ours, blocks));
-    (ours, merged, frozen)
+    (ours, merged)
 }
 
 /// The embedded boundary at one stage time, as the residual reads it.
@@ -446,25 +470,27 @@ mod tests {
     use crate::semidiscretization::Numerics;
     use interface_protocol::case::Tracking;
 
-    /// The parallel replacement of the looked-at edges equals a plain one (kept entries not
-    /// looked at, then the new ones, sorted) on lists spanning many ranges.
+    /// Replacing the looked-at edges by stretches equals a plain replacement (kept entries not
+    /// looked at, then the new ones, sorted), from few looked-at edges to all of them, and
+    /// counts the frozen entries replaced.
     #[test]
-    fn replacing_looked_at_edges_by_ranges_is_a_plain_merge() {
+    fn replacing_looked_at_edges_is_a_plain_merge() {
         let mut state = 99u64;
         let mut next = |m: u64| {
             state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (state >> 33) % m
         };
         let kinds = [SpecialKind::Dead, SpecialKind::Frozen, SpecialKind::Cut];
-        for _ in 0..20 {
+        for round in 0..30 {
             let n = 1 + next(3000) as u32;
+            let every = [1, 2, 5, 50, 400][round % 5];
             let mut old = Vec::new();
             let (mut looked, mut now) = (Vec::new(), Vec::new());
             for e in 0..n {
                 if next(3) == 0 {
                     old.push(SpecialEdge { edge: e, kind: kinds[next(3) as usize] });
                 }
-                if next(5) == 0 {
+                if next(every) == 0 {
                     looked.push(e);
                     if next(2) == 0 {
                         now.push(SpecialEdge { edge: e, kind: kinds[next(3) as usize] });
@@ -475,8 +501,11 @@ mod tests {
                 old.iter().filter(|s| looked.binary_search(&s.edge).is_err()).copied().collect();
             want.extend(&now);
             want.sort_by_key(|s| s.edge);
-            assert!(old.len() > 2 * UPDATE_CHUNK || n < 600, "{} entries", old.len());
-            assert_eq!(replace_sorted(&old, &looked, &now), want);
+            let replaced = old
+                .iter()
+                .filter(|s| s.kind == SpecialKind::Frozen && looked.binary_search(&s.edge).is_ok())
+                .count();
+            assert_eq!(replace_sorted(&old, &looked, &now), (want, replaced), "round {round}");
         }
     }
 
@@ -516,11 +545,18 @@ mod tests {
     }
 
     #[test]
-    fn union_of_sorted_lists_is_sorted_and_once_each() {
+    fn union_and_symmetric_difference_of_sorted_lists() {
         assert_eq!(union_sorted(&[1, 4, 9], &[0, 4, 4, 10]), vec![0, 1, 4, 9, 10]);
         assert_eq!(union_sorted(&[], &[2, 2, 3]), vec![2, 3]);
         assert_eq!(union_sorted(&[5, 7], &[]), vec![5, 7]);
         assert!(union_sorted::<u32>(&[], &[]).is_empty());
+        assert_eq!(
+            symmetric_difference(&[1, 4, 9, 12], &[0, 4, 10, 12, 13]),
+            vec![0, 1, 9, 10, 13]
+        );
+        assert_eq!(symmetric_difference(&[], &[2, 3]), vec![2, 3]);
+        assert_eq!(symmetric_difference(&[5, 7], &[]), vec![5, 7]);
+        assert!(symmetric_difference(&[3, 8], &[3, 8]).is_empty());
         // Edges with their ends, as Alg. 4.1 keeps them.
         let (a, b) = ([(1, [1, 2]), (4, [2, 5])], [(0, [0, 3]), (1, [1, 2])]);
         assert_eq!(union_sorted(&a, &b), vec![(0, [0, 3]), (1, [1, 2]), (4, [2, 5])]);
