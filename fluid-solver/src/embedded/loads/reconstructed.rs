@@ -52,10 +52,10 @@ pub(super) fn loads(view: &LoadView, out: &mut [[f64; 3]]) {
     vertex_loads(view, |_, f, tri, bary| distribute(view.surface, tri, bary, f, out));
 }
 
-/// Calls `sink(x, f, triangle, bary)` for every vertex contribution of the reconstructed
-/// interface: the intersection point `x`, its force `f` on the structure, and the structure
-/// triangle hit there with the barycentric coordinates of `x` in it. Only the cells around the
-/// cut edges are visited, in ascending order.
+/// Calls `sink(x, f, triangle, bary)` for every vertex of the reconstructed interface, in cut
+/// order: the intersection point `x`, its force `f` on the structure (summed over the polygons
+/// it belongs to, in cell order), and the structure triangle hit there with the barycentric
+/// coordinates of `x` in it. Only the cells around the cut edges are visited.
 pub(super) fn vertex_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3])) {
     vertex_loads_in(view, &cut_cells(view), sink);
 }
@@ -63,12 +63,11 @@ pub(super) fn vertex_loads(view: &LoadView, sink: impl FnMut([f64; 3], [f64; 3],
 /// The cut cells with their cut edges: a pair `(cell, cut)` for every cell holding both ends of
 /// cut edge `cut`, ascending. Every cell with a cut edge appears, so every cell that can hold a
 /// polygon. The cells of an edge are the common entries of its ends' node-to-cell rows (both
-/// ascending: a merge, which reads no cell), found in parallel and sorted in parallel as `u64`
-/// keys `cell << 32 | cut` (the pairs are distinct, so the order is the same for any number of
-/// threads).
+/// ascending: a merge, which reads no cell), found in parallel in cut order, then ordered by
+/// cell with a stable radix sort (so by cut within a cell), the same for any number of threads.
 pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
     let adjacency = view.adjacency;
-    let mut keys: Vec<u64> = view
+    let pairs: Vec<(u32, u32)> = view
         .cuts
         .par_iter()
         .enumerate()
@@ -82,7 +81,7 @@ pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
                     std::cmp::Ordering::Less => x += 1,
                     std::cmp::Ordering::Greater => y += 1,
                     std::cmp::Ordering::Equal => {
-                        pairs.push(u64::from(a[x]) << 32 | k as u64);
+                        pairs.push((a[x], k as u32));
                         x += 1;
                         y += 1;
                     }
@@ -92,9 +91,39 @@ pub(super) fn cut_cells(view: &LoadView) -> Vec<(u32, u32)> {
         })
         .flatten_iter()
         .collect();
-    keys.par_sort_unstable();
-    keys.into_par_iter().map(|key| ((key >> 32) as u32, key as u32)).collect()
+    let sorted = sort_by_cell(pairs, view.mesh.cells.len());
+    debug_assert!(sorted.windows(2).all(|w| w[0] < w[1]), "cut cells out of order");
+    sorted
 }
+
+/// `pairs` stably sorted by their first entry (each `< n_cells`): least significant digit
+/// first, [`RADIX_BITS`] at a time.
+fn sort_by_cell(mut pairs: Vec<(u32, u32)>, n_cells: usize) -> Vec<(u32, u32)> {
+    let bits = usize::BITS - n_cells.saturating_sub(1).leading_zeros();
+    let mut other = vec![(0, 0); pairs.len()];
+    let mut shift = 0;
+    while shift < bits {
+        let digit = |c: u32| ((c >> shift) as usize) & ((1 << RADIX_BITS) - 1);
+        let mut start = vec![0usize; (1 << RADIX_BITS) + 1];
+        for &(c, _) in &pairs {
+            start[digit(c) + 1] += 1;
+        }
+        for d in 0..1 << RADIX_BITS {
+            start[d + 1] += start[d];
+        }
+        for &p in &pairs {
+            let d = digit(p.0);
+            other[start[d]] = p;
+            start[d] += 1;
+        }
+        std::mem::swap(&mut pairs, &mut other);
+        shift += RADIX_BITS;
+    }
+    pairs
+}
+
+/// Bits of a cell number sorted per pass of [`sort_by_cell`].
+const RADIX_BITS: u32 = 11;
 
 /// [`vertex_loads`] over the `(cell, cut)` pairs `pairs` (ascending), which must include every
 /// cut edge of every cut cell.
@@ -104,40 +133,44 @@ pub(super) fn vertex_loads_in(
     mut sink: impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
 ) {
     let joining = joining_cuts(view);
-    // Each cut's vertex once (about five cells share it).
-    let vertices: Vec<Vertex> =
+    // Each cut's vertex once (about five cells share it), with its edge's ends.
+    let vertices: Vec<(Vertex, [u32; 2])> =
         (0..view.cuts.len()).into_par_iter().with_min_len(1024).map(|k| vertex(view, k)).collect();
     let cells: Vec<&[(u32, u32)]> = pairs.chunk_by(|a, b| a.0 == b.0).collect();
-    // The cells' contributions in parallel, handed to `sink` in cell order (as one pass would).
-    let per_chunk: Vec<Vec<Contribution>> = cells
+    // The cells' vertex forces in parallel, summed per cut in cell order (as one pass would).
+    let per_chunk: Vec<Vec<(u32, [f64; 3])>> = cells
         .par_chunks(CELLS_PER_TASK)
         .map(|chunk| {
             let mut found = Vec::new();
             let mut polygon = Vec::with_capacity(12);
             for cuts in chunk {
                 let cell = &view.mesh.cells[cuts[0].0 as usize];
-                let cut_of = cell_cuts(view, &joining, cell, cuts);
+                let cut_of = cell_cuts(&vertices, &joining, cell, cuts);
                 if cut_of.iter().flatten().count() < 3 {
                     continue;
                 }
                 cycles(cell, &cut_of, |cycle, walked| {
                     polygon.clear();
-                    polygon.extend(cycle.iter().map(|&k| vertices[k]));
+                    polygon.extend(cycle.iter().map(|&k| vertices[k].0));
                     orient(&mut polygon, walked);
-                    integrate(view, &polygon, &mut |x, f, t, b| found.push((x, f, t, b)));
+                    integrate(&polygon, &mut |k, f| found.push((k as u32, f)));
                 });
             }
             found
         })
         .collect();
-    for (x, f, t, b) in per_chunk.into_iter().flatten() {
-        sink(x, f, t, b);
+    let mut force: Vec<Option<[f64; 3]>> = vec![None; view.cuts.len()];
+    for (k, f) in per_chunk.into_iter().flatten() {
+        let sum = force[k as usize].get_or_insert([0.0; 3]);
+        *sum = add(*sum, f);
+    }
+    for (k, f) in force.into_iter().enumerate() {
+        if let Some(f) = f {
+            let cut = &view.cuts[k];
+            sink(vertices[k].0.x, f, cut.triangle, cut.bary);
+        }
     }
 }
-
-/// One vertex contribution: the point, its force, the structure triangle and the barycentric
-/// coordinates there.
-type Contribution = ([f64; 3], [f64; 3], u32, [f64; 3]);
 
 /// Cut cells per parallel task of [`vertex_loads_in`].
 const CELLS_PER_TASK: usize = 256;
@@ -164,7 +197,8 @@ fn joining_cuts(view: &LoadView) -> Vec<bool> {
         }
     }
     view.cuts
-        .iter()
+        .par_iter()
+        .with_min_len(1024)
         .map(|c| {
             let [i, j] = view.mesh.edges[c.edge as usize];
             let one_fluid_shell = part[c.triangle as usize].is_some_and(|r| !reached[r as usize].1);
@@ -174,9 +208,10 @@ fn joining_cuts(view: &LoadView) -> Vec<bool> {
 }
 
 /// For each local edge of `cell`, the index of its cut edge, if it is cut and joins the
-/// reconstruction (`joining`, per cut edge), from the cell's `(cell, cut)` pairs.
+/// reconstruction (`joining`, per cut edge), from the cell's `(cell, cut)` pairs and the ends
+/// of each cut's edge (`vertices`).
 fn cell_cuts(
-    view: &LoadView,
+    vertices: &[(Vertex, [u32; 2])],
     joining: &[bool],
     cell: &Cell,
     pairs: &[(u32, u32)],
@@ -188,7 +223,7 @@ fn cell_cuts(
         if !joining[k] {
             continue;
         }
-        let [i, j] = view.mesh.edges[view.cuts[k].edge as usize];
+        let [i, j] = vertices[k].1;
         let l = local.iter().position(|&[a, b]| {
             let (p, q) = (cell.nodes[a], cell.nodes[b]);
             (p.min(q), p.max(q)) == (i, j)
@@ -271,8 +306,8 @@ fn cycles(cell: &Cell, cut_of: &[Option<usize>; 12], mut visit: impl FnMut(&[usi
 }
 
 /// The polygon vertex of cut `k`: its intersection point and `q = p*_- - p*_+`, the `+` end the
-/// one `n_E` points to (the orientation contract).
-fn vertex(view: &LoadView, k: usize) -> Vertex {
+/// one `n_E` points to (the orientation contract); with the ends of its edge.
+fn vertex(view: &LoadView, k: usize) -> (Vertex, [u32; 2]) {
     let cut = &view.cuts[k];
     let e = cut.edge as usize;
     let [i, j] = view.mesh.edges[e];
@@ -281,7 +316,9 @@ fn vertex(view: &LoadView, k: usize) -> Vertex {
     let [pi, pj] = view.p_star[k].map(or_zero);
     let towards_j = dot(wall_normal_from_i(cut.normal, d, view.mesh.edge_normals[e]), cut.normal);
     let (q, s) = if towards_j > 0.0 { (pi - pj, 1.0) } else { (pj - pi, -1.0) };
-    Vertex { x: add(xi, scale(d, cut.alpha)), q, across: scale(d, s / norm(d)), cut: k }
+    let vertex =
+        Vertex { x: add(xi, scale(d, cut.alpha)), q, across: scale(d, s / norm(d)), cut: k };
+    (vertex, [i, j])
 }
 
 /// Orders the vertices of a polygon that did not come from the face walk by angle about their
@@ -325,12 +362,8 @@ fn any_perpendicular(n: [f64; 3]) -> [f64; 3] {
 }
 
 /// Integrates `q n̂` over the triangles of an oriented polygon into per-vertex forces (Eq. 5.18)
-/// and hands them to `sink` with their cuts' triangles and barycentric coordinates.
-fn integrate(
-    view: &LoadView,
-    poly: &[Vertex],
-    sink: &mut impl FnMut([f64; 3], [f64; 3], u32, [f64; 3]),
-) {
+/// and hands each to `sink` with its vertex's cut.
+fn integrate(poly: &[Vertex], sink: &mut impl FnMut(usize, [f64; 3])) {
     let m = poly.len();
     let mut force = [[0.0; 3]; 12];
     if m == 3 {
@@ -350,8 +383,7 @@ fn integrate(
         force[..m].iter_mut().for_each(|f| *f = add(*f, share));
     }
     for (v, f) in poly.iter().zip(&force) {
-        let cut = &view.cuts[v.cut];
-        sink(v.x, *f, cut.triangle, cut.bary);
+        sink(v.cut, *f);
     }
 }
 
