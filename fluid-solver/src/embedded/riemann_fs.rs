@@ -120,6 +120,31 @@ pub fn wall_normal_from_i(n_e: [f64; 3], d_ij: [f64; 3], nu_ij: [f64; 3]) -> [f6
 /// Alg. 5.1 for one end of one cut edge (the end must be an active node): with gradients in the
 /// view, the second-order form of [`interface`]; without, the thesis' form, `F(W_i, W*(W_i), ν)`.
 pub fn one_sided(view: &WallFluxView, cut: &CutEdge, end: End) -> Result<OneSided, WallFluxError> {
+    let s = wall_states(view, cut, end)?;
+    // Step 4: the numerical flux of the ordinary edges (Eq. 5.8), from the node side's state and
+    // the wall side's.
+    let flux = numerical_flux(view.scheme, &s.eos, &s.left, &s.right, &s.facet);
+    Ok(OneSided { flux, rho: s.star.w[0], p: s.star.w[4], clipped: s.star.clipped })
+}
+
+/// The two states of the facet flux of [`one_sided`] (the node side's and the wall side's), its
+/// facet normal and EOS, and the wall state `W*` (the loads read its pressure).
+#[derive(Debug, Clone, Copy)]
+pub struct WallStates {
+    pub left: [f64; 5],
+    pub right: [f64; 5],
+    pub facet: [f64; 3],
+    pub eos: Eos,
+    pub star: Star,
+}
+
+/// Steps 1-3 of Alg. 5.1 for one end of one cut edge (the end must be an active node): the states
+/// [`one_sided`] takes the flux between.
+pub fn wall_states(
+    view: &WallFluxView,
+    cut: &CutEdge,
+    end: End,
+) -> Result<WallStates, WallFluxError> {
     let mesh = view.mesh;
     let e = cut.edge as usize;
     let [i, j] = mesh.edges[e];
@@ -156,9 +181,7 @@ pub fn one_sided(view: &WallFluxView, cut: &CutEdge, end: End) -> Result<OneSide
             [rho, w_in[1] + dv * n_wall[0], w_in[2] + dv * n_wall[1], w_in[3] + dv * n_wall[2], p];
         Ok(Star { w, clipped: s.clipped })
     };
-    // Step 4: the numerical flux of the ordinary edges (Eq. 5.8), from the node side's state and
-    // the wall side's.
-    let (left, right, s) = match view.grad {
+    let (left, right, star) = match view.grad {
         None => {
             let s = star(wi)?;
             (*wi, s.w, s)
@@ -170,8 +193,7 @@ pub fn one_sided(view: &WallFluxView, cut: &CutEdge, end: End) -> Result<OneSide
             interface::facet_states(view.limiter, &mat.eos, wi, g, towards, alpha, star)?
         }
     };
-    let flux = numerical_flux(view.scheme, &mat.eos, &left, &right, &facet);
-    Ok(OneSided { flux, rho: s.w[0], p: s.w[4], clipped: s.clipped })
+    Ok(WallStates { left, right, facet, eos: mat.eos, star })
 }
 
 /// A wall state of the one-sided problem.

@@ -8,7 +8,8 @@
 //! rebuilt at the ends of the edges whose status changed), read by the residual at each stage
 //! time.
 
-use super::riemann_fs::{one_sided, End, WallFluxError, WallFluxView, WallMaterial, WallPressures};
+use super::riemann_fs::{one_sided, wall_states, End, WallFluxError, WallFluxView};
+use super::riemann_fs::{WallMaterial, WallPressures};
 use super::tracker::Tracker;
 use crate::flux::wall_flux;
 use crate::mesh::blocks::Window;
@@ -440,9 +441,9 @@ impl Wall<'_> {
                 let (mut ps, mut clips) = ([f64::NAN; 2], 0);
                 for (k, (end, node)) in [(End::I, i), (End::J, j)].into_iter().enumerate() {
                     if self.tracker.active[node] {
-                        let s = one_sided(&view, cut, end)?;
-                        ps[k] = s.p;
-                        clips += s.clipped as usize;
+                        let star = wall_states(&view, cut, end)?.star;
+                        ps[k] = star.w[4];
+                        clips += star.clipped as usize;
                     }
                 }
                 Ok((ps, clips))
