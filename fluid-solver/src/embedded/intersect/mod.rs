@@ -10,6 +10,7 @@
 //! `Surface::node_at` at a stage time); the hierarchy's boxes must hold the triangles there
 //! ([`super::bvh::Bvh::refit`] covers `x_a` and `x_b`, [`super::bvh::Bvh::refit_with`] any other).
 
+mod by_node;
 mod closest;
 pub mod collision;
 mod crossings;
@@ -17,6 +18,7 @@ mod halves;
 pub mod near;
 pub mod projection;
 mod pseudo_normals;
+mod reach;
 pub mod skin;
 
 pub use collision::{collision, collision_near};

@@ -10,7 +10,7 @@
 //! reach boxes of both its ends meet a triangle box: each pass over [`Near`] gives
 //! exactly what the same pass gives over the whole mesh. A static hierarchy over the reach boxes
 //! ([`NodeBoxes`], built once with the mesh) is queried with each triangle box, in parallel, and
-//! the pairs found are regrouped by node by counting ([`pairs_by_node`]): the reach boxes are all
+//! the pairs found are regrouped by node by counting (`by_node.rs`): the reach boxes are all
 //! of a size, so each query costs about what it finds, with no query from the nodes inside a
 //! closed surface that meet none.
 //!
@@ -28,91 +28,18 @@
 //! a pass first tests those six bits and then the box itself: the same triangles, from a scan
 //! that skips most of the list without reading the triangle boxes.
 
+use super::by_node::{concat, join_offsets, pairs_by_node, par_node_chunks};
 pub(super) use super::halves::Split;
-use super::OCCLUSION;
+pub use super::reach::{NodeBoxes, ReachBoxes};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
 use crate::prefetch::prefetch;
 
-/// Nodes per parallel task of the list passes (a few thousand near nodes of long lists make
-/// several tasks).
-const CHUNK: usize = 256;
-
 /// Places ahead in its node list at which a pass hints the rows it will read
 /// ([`Near::prefetch_ahead`]): the near nodes lie scattered over the mesh arrays, and each
 /// node's rows are a chain of loads (bounds, then list).
 pub const AHEAD: usize = 8;
-
-/// The hierarchy over the reach boxes of the mesh nodes (module docs), built once per mesh.
-#[derive(Debug, Clone, PartialEq)]
-pub struct NodeBoxes {
-    pub(super) tree: Bvh,
-    /// The largest occlusion radius of a node, by which every reach box is widened (so a node's
-    /// box holds the occlusion ball of each of its neighbours, and an edge with an occluded end
-    /// has both ends near) and the halves of each reach box overlap.
-    pub(super) rho: f64,
-}
-
-impl NodeBoxes {
-    pub fn build(mesh: &Mesh, adjacency: &NodeEdges) -> NodeBoxes {
-        let reach = ReachBoxes::computed(mesh, adjacency);
-        let (lo, hi) = (0..mesh.n_nodes()).map(|i| reach.of(i)).unzip();
-        NodeBoxes { tree: Bvh::over_boxes(lo, hi), rho: reach.rho() }
-    }
-
-    /// Number of nodes.
-    pub fn len(&self) -> usize {
-        self.tree.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.tree.is_empty()
-    }
-
-    /// Memory in bytes.
-    pub fn memory_bytes(&self) -> usize {
-        self.tree.memory_bytes()
-    }
-}
-
-/// The reach boxes of the nodes of a mesh: read from [`NodeBoxes`], or computed as it computes
-/// them (the same values).
-#[derive(Clone, Copy)]
-pub enum ReachBoxes<'a> {
-    Stored(&'a NodeBoxes),
-    Computed { mesh: &'a Mesh, adjacency: &'a NodeEdges, rho: f64 },
-}
-
-impl<'a> ReachBoxes<'a> {
-    /// The reach boxes of `mesh` computed from its adjacency, widened by the largest occlusion
-    /// radius of a node.
-    pub fn computed(mesh: &'a Mesh, adjacency: &'a NodeEdges) -> ReachBoxes<'a> {
-        let radius = |h: f64| Some(OCCLUSION * h).filter(|r| r.is_finite());
-        let rho = adjacency.h_min.iter().filter_map(|&h| radius(h)).fold(0.0, f64::max);
-        ReachBoxes::Computed { mesh, adjacency, rho }
-    }
-
-    /// The widening `ρ` of every box.
-    pub fn rho(&self) -> f64 {
-        match self {
-            ReachBoxes::Stored(boxes) => boxes.rho,
-            ReachBoxes::Computed { rho, .. } => *rho,
-        }
-    }
-
-    /// The reach box of node `i`.
-    #[inline]
-    pub fn of(&self, i: usize) -> ([f64; 3], [f64; 3]) {
-        match self {
-            ReachBoxes::Stored(boxes) => boxes.tree.triangle_box(i),
-            ReachBoxes::Computed { mesh, adjacency, rho } => {
-                let (lo, hi) = adjacency.node_box(mesh, i);
-                (lo.map(|v| v - rho), hi.map(|v| v + rho))
-            }
-        }
-    }
-}
 
 /// The mesh nodes whose reach box meets a triangle box, ascending (their edges: [`Near::edges`]);
 /// with, from [`Near::find`], the triangles whose box meets each node's reach box and the halves
@@ -353,132 +280,11 @@ impl Near {
     }
 }
 
-/// `run` over `nodes` by runs of [`CHUNK`], in parallel, the results in the order of `nodes`
-/// (the same for any number of threads).
-pub(super) fn par_node_chunks<T: Send>(
-    nodes: &[u32],
-    run: impl Fn(&[u32]) -> T + Sync + Send,
-) -> Vec<T> {
-    use rayon::prelude::*;
-    nodes.par_chunks(CHUNK).map(run).collect()
-}
-
-/// The pairs of a reach box of `boxes` and one of the `n_items` item boxes (`box_of`) that
-/// overlap, grouped by node: the nodes with any (ascending), and per node of the mesh the offsets
-/// of its items in the second list (each node's ascending). Each item box queries the hierarchy
-/// of reach boxes, by runs of items in parallel (a query costs about what it finds: the reach
-/// boxes are all of a size), and the pairs are regrouped by node by counting, in item order.
-pub(super) fn pairs_by_node(
-    boxes: &NodeBoxes,
-    n_items: usize,
-    box_of: impl Fn(usize) -> ([f64; 3], [f64; 3]) + Sync,
-) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
-    use rayon::prelude::*;
-    let n = boxes.len();
-    // Per run of items: the nodes each item box meets, and how many.
-    let found: Vec<(Vec<u32>, Vec<u32>)> = (0..n_items.div_ceil(ITEMS))
-        .into_par_iter()
-        .map(|c| {
-            let (mut nodes, mut counts) = (Vec::new(), Vec::new());
-            for r in c * ITEMS..((c + 1) * ITEMS).min(n_items) {
-                let start = nodes.len();
-                let (lo, hi) = box_of(r);
-                boxes.tree.for_each_overlap(&lo, &hi, |i| nodes.push(i));
-                counts.push((nodes.len() - start) as u32);
-            }
-            (nodes, counts)
-        })
-        .collect();
-    let mut offsets = vec![0u32; n + 1];
-    for (nodes, _) in &found {
-        for &i in nodes {
-            offsets[i as usize + 1] += 1;
-        }
-    }
-    let listed: Vec<u32> = (0..n as u32).filter(|&i| offsets[i as usize + 1] > 0).collect();
-    for i in 0..n {
-        offsets[i + 1] += offsets[i];
-    }
-    // Items in ascending order, so each node's come out ascending.
-    let mut next = offsets.clone();
-    let mut kept = vec![0u32; offsets[n] as usize];
-    let mut r = 0u32;
-    for c in 0..found.len() {
-        let (nodes, counts) = &found[c];
-        let mut at = 0;
-        for &count in counts {
-            for &i in &nodes[at..at + count as usize] {
-                kept[next[i as usize] as usize] = r;
-                next[i as usize] += 1;
-            }
-            at += count as usize;
-            r += 1;
-        }
-    }
-    (listed, offsets, kept)
-}
-
-/// Item boxes per parallel task of [`pairs_by_node`].
-const ITEMS: usize = 256;
-
-/// The per-node offsets of lists written by runs of the ascending `candidates`
-/// ([`par_node_chunks`]; run `c` listed the nodes `runs[c].0` with `runs[c].1` items each): the
-/// listed nodes, ascending, and the offsets of each mesh node's items in the joined list (`n + 1`
-/// of them), filled in parallel, each run the offsets of the nodes from its first candidate to
-/// the next run's.
-fn join_offsets(n: usize, candidates: &[u32], runs: &[(&[u32], &[u32])]) -> (Vec<u32>, Vec<u32>) {
-    use rayon::prelude::*;
-    let mut offsets = vec![0u32; n + 1];
-    let mut listed = vec![0u32; runs.iter().map(|r| r.0.len()).sum()];
-    let mut jobs = Vec::with_capacity(runs.len());
-    let (mut rest_offsets, mut rest_listed) = (&mut offsets[1..], &mut listed[..]);
-    let (mut first, mut base) = (0usize, 0u32);
-    for (c, &(nodes, counts)) in runs.iter().enumerate() {
-        let end = candidates.get((c + 1) * CHUNK).map_or(n, |&i| i as usize);
-        let (ends, rest) = std::mem::take(&mut rest_offsets).split_at_mut(end - first);
-        rest_offsets = rest;
-        let (to, rest) = std::mem::take(&mut rest_listed).split_at_mut(nodes.len());
-        rest_listed = rest;
-        jobs.push((first, base, ends, to, nodes, counts));
-        base += counts.iter().sum::<u32>();
-        first = end;
-    }
-    jobs.into_par_iter().for_each(|(first, mut end, ends, to, nodes, counts)| {
-        to.copy_from_slice(nodes);
-        // The end of each listed node's items, held over the unlisted nodes up to the next.
-        let mut from = 0;
-        for (&i, &c) in nodes.iter().zip(counts) {
-            let k = i as usize - first;
-            ends[from..k].fill(end);
-            end += c;
-            ends[k] = end;
-            from = k + 1;
-        }
-        ends[from..].fill(end);
-    });
-    (listed, offsets)
-}
-
-/// The slices of `parts` one after the other, copied in parallel.
-fn concat<T: Copy + Default + Send + Sync>(parts: &[&[T]]) -> Vec<T> {
-    use rayon::prelude::*;
-    let mut out = vec![T::default(); parts.iter().map(|p| p.len()).sum()];
-    let mut jobs = Vec::with_capacity(parts.len());
-    let mut rest = &mut out[..];
-    for &part in parts {
-        let (to, r) = std::mem::take(&mut rest).split_at_mut(part.len());
-        rest = r;
-        jobs.push((to, part));
-    }
-    jobs.into_par_iter().for_each(|(to, part)| to.copy_from_slice(part));
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::embedded::intersect::{collision, collision_near, projection, projection_near};
-    use crate::embedded::intersect::{Intersections, SurfaceAt};
+    use crate::embedded::intersect::{Intersections, SurfaceAt, OCCLUSION};
     use crate::embedded::status::swept_nodes_near;
     use crate::embedded::status::NodeStatus;
     use crate::embedded::status::{flood_fill, swept_nodes, swept_nodes_among, update_sides};

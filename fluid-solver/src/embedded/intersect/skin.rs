@@ -19,7 +19,8 @@
 //! hierarchy size triggers the next rebuild. Nothing here is state of the run: a restarted run
 //! rebuilds at its first step and gets the same [`Near`].
 
-use super::near::{pairs_by_node, par_node_chunks, Lists, Near, NodeBoxes, Split, AHEAD};
+use super::by_node::{pairs_by_node, par_node_chunks};
+use super::near::{Lists, Near, NodeBoxes, Split, AHEAD};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
