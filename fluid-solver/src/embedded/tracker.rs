@@ -7,7 +7,7 @@
 //! only at the near part: Alg. 4.1 keeps its inside ([`KeptInside`]) and the sides are redecided
 //! only at the swept, occluded and unsided nodes ([`update_sides_among`]).
 
-use super::adjacency::NodeEdges;
+use super::adjacency::{ascending_once, NodeEdges};
 use super::bvh::Bvh;
 use super::intersect::{
     collision_near, projection_near, Intersections, KeptInside, Near, NearSkin, NodeBoxes,
@@ -163,16 +163,8 @@ impl Tracker {
     /// The active end nodes of the cut edges, ascending, each once (the nodes whose states and
     /// gradients the wall pressures read).
     pub fn cut_edge_ends(&self, mesh: &Mesh) -> Vec<u32> {
-        let mut nodes: Vec<u32> = self
-            .cuts
-            .cuts
-            .iter()
-            .flat_map(|c| mesh.edges[c.edge as usize])
-            .filter(|&i| self.active[i as usize])
-            .collect();
-        nodes.sort_unstable();
-        nodes.dedup();
-        nodes
+        let ends = self.cuts.cuts.iter().flat_map(|c| mesh.edges[c.edge as usize]);
+        ascending_once(mesh.n_nodes(), ends.filter(|&i| self.active[i as usize]))
     }
 
     /// Thesis §4.4: the largest distance a surface node moved over the step, in fluid edge

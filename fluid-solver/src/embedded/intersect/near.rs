@@ -31,7 +31,7 @@
 use super::by_node::{concat, join_offsets, pairs_by_node, par_node_chunks};
 pub(super) use super::halves::Split;
 pub use super::reach::{NodeBoxes, ReachBoxes};
-use crate::embedded::adjacency::NodeEdges;
+use crate::embedded::adjacency::{ascending_once, NodeEdges};
 use crate::embedded::bvh::{overlaps, Bvh};
 use crate::mesh::Mesh;
 use crate::prefetch::prefetch;
@@ -178,21 +178,8 @@ impl Near {
 
     /// Every edge touching a node of the near part, ascending (through a bit set over the edges).
     pub fn edges(&self, mesh: &Mesh, adjacency: &NodeEdges) -> Vec<u32> {
-        let mut bits = vec![0u64; mesh.n_edges().div_ceil(64)];
-        for &i in &self.nodes {
-            for &e in adjacency.edges_of(i as usize) {
-                bits[e as usize / 64] |= 1 << (e % 64);
-            }
-        }
-        let mut edges = Vec::new();
-        for (w, &word) in bits.iter().enumerate() {
-            let mut word = word;
-            while word != 0 {
-                edges.push(64 * w as u32 + word.trailing_zeros());
-                word &= word - 1;
-            }
-        }
-        edges
+        let edges = self.nodes.iter().flat_map(|&i| adjacency.edges_of(i as usize));
+        ascending_once(mesh.n_edges(), edges.copied())
     }
 
     /// Prefetch hints ([`crate::prefetch`]) for a pass at place `k` of `nodes`: the coordinates
