@@ -126,7 +126,7 @@ impl Tracker {
     /// The part of the mesh the refitted hierarchy reaches ([`Near::find`], through the kept
     /// pairs of [`NearSkin`]).
     pub fn near(&mut self, mesh: &Mesh) -> Near {
-        self.near_skin.find(mesh, &self.node_boxes, &self.bvh)
+        self.near_skin.find(mesh, &self.node_boxes, &self.bvh, &self.surface)
     }
 
     /// The cut edges of the surface at `x_b` (Alg. 4.1 or 4.2), testing the nodes and edges of

@@ -10,7 +10,9 @@
 //! the fastest run is stretched by the skin `δ` (a surface moving at a steady velocity keeps
 //! its pairs for as many steps as a skin of `δ` on every side would, with far fewer pairs: the
 //! skin lies only where the surface is going). Without a last call of the same runs (the first,
-//! a new topology or a new run length) every side is widened by `δ`. While each run's current
+//! a new topology or a new run length) the nodal velocities at `t_b` stand in for the motion
+//! (the bounds of each run's nodal velocity components), and where those are all zero every
+//! side is widened by `δ`. While each run's current
 //! box stays inside its widened one, a triangle whose box meets a reach box now lies in a run
 //! kept for that node, so filtering the kept runs by their current boxes, and the triangles of
 //! the runs that pass by theirs, gives exactly the pairs of a fresh search, in ascending order:
@@ -23,6 +25,7 @@ use super::by_node::{pairs_by_node, par_node_chunks};
 use super::near::{Lists, Near, NodeBoxes, Split, AHEAD};
 use crate::embedded::adjacency::NodeEdges;
 use crate::embedded::bvh::{overlaps, Bvh};
+use crate::embedded::Surface;
 use crate::mesh::Mesh;
 use crate::prefetch::prefetch;
 
@@ -84,11 +87,12 @@ impl NearSkin {
             })
     }
 
-    /// Widens the current run boxes of `bvh` and keeps the pairs they make with the reach boxes:
-    /// by [`SLACK`] on every side and by the motion since the last call scaled to [`SKIN`] for
-    /// the fastest run (module docs), or by [`SKIN`] on every side without a last call of the
-    /// same runs (the first, a new topology or a new run length).
-    fn rebuild(&mut self, boxes: &NodeBoxes, bvh: &Bvh) {
+    /// Widens the current run boxes of `bvh` (over `surface`) and keeps the pairs they make with
+    /// the reach boxes: by [`SLACK`] on every side and by the motion scaled to [`SKIN`] for the
+    /// fastest run (module docs): the motion since the last call, or without a last call of the
+    /// same runs (the first, a new topology or a new run length) the nodal velocities; by
+    /// [`SKIN`] on every side where that motion is zero.
+    fn rebuild(&mut self, boxes: &NodeBoxes, bvh: &Bvh, surface: &Surface) {
         let last_run = self.run;
         self.run = 1;
         let mut runs = RunBoxes::new(bvh, 1);
@@ -102,11 +106,12 @@ impl NearSkin {
         let same = self.run == last_run
             && self.last.lo.len() == runs.lo.len()
             && self.topology_version == bvh.topology_version;
-        (self.lo, self.hi) = if same {
-            runs.widened_ahead(&self.last, self.skin, self.slack)
+        let (down, up) = if same {
+            runs.motion_since(&self.last)
         } else {
-            runs.widened(self.skin)
+            velocity_bounds(surface, self.run)
         };
+        (self.lo, self.hi) = runs.widened_ahead(&down, &up, self.skin, self.slack);
         self.triangles = bvh.len();
         self.topology_version = bvh.topology_version;
         let (lo, hi) = (&self.lo, &self.hi);
@@ -115,13 +120,14 @@ impl NearSkin {
         self.rebuilds += 1;
     }
 
-    /// [`Near::find`] for `bvh`'s current boxes, from the kept pairs (rebuilt when they no
-    /// longer hold every pair).
-    pub fn find(&mut self, mesh: &Mesh, boxes: &NodeBoxes, bvh: &Bvh) -> Near {
+    /// [`Near::find`] for `bvh`'s current boxes (the hierarchy of `surface`), from the kept
+    /// pairs (rebuilt when they no longer hold every pair).
+    pub fn find(&mut self, mesh: &Mesh, boxes: &NodeBoxes, bvh: &Bvh, surface: &Surface) -> Near {
         debug_assert_eq!(boxes.len(), mesh.n_nodes(), "node boxes of another mesh");
+        debug_assert_eq!(bvh.len(), surface.triangles.len(), "hierarchy of another surface");
         let mut runs = RunBoxes::new(bvh, self.run);
         if !self.holds(bvh, &runs) {
-            self.rebuild(boxes, bvh);
+            self.rebuild(boxes, bvh, surface);
             runs = RunBoxes::new(bvh, self.run);
         }
         self.last = runs;
@@ -202,30 +208,35 @@ impl RunBoxes {
         RunBoxes { lo, hi }
     }
 
-    /// Every box widened by `skin` on every side.
-    fn widened(&self, skin: f64) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
-        let lo = self.lo.iter().map(|lo| lo.map(|v| v - skin)).collect();
-        let hi = self.hi.iter().map(|hi| hi.map(|v| v + skin)).collect();
-        (lo, hi)
-    }
-
-    /// Every box widened by `slack` on every side and stretched ahead by its motion since
-    /// `last` (the same runs), scaled so the fastest moves `skin`.
-    fn widened_ahead(
-        &self,
-        last: &RunBoxes,
-        skin: f64,
-        slack: f64,
-    ) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    /// The motion of the lower and of the upper corner of each box since `last` (the same
+    /// runs).
+    fn motion_since(&self, last: &RunBoxes) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
         let motion = |now: &[[f64; 3]], then: &[[f64; 3]]| -> Vec<[f64; 3]> {
             now.iter().zip(then).map(|(a, b)| [0, 1, 2].map(|d| a[d] - b[d])).collect()
         };
-        let (down, up) = (motion(&self.lo, &last.lo), motion(&self.hi, &last.hi));
-        let fastest = down.iter().chain(&up).flatten().fold(0.0, |m: f64, v| m.max(v.abs()));
-        let scale = if fastest > 0.0 && fastest.is_finite() { skin / fastest } else { 0.0 };
-        let lo = self.lo.iter().zip(&down);
+        (motion(&self.lo, &last.lo), motion(&self.hi, &last.hi))
+    }
+
+    /// Every box widened by `slack` on every side and stretched ahead by the motion of its
+    /// corners (`down` for the lower, `up` for the upper), scaled so the fastest moves `skin`;
+    /// by `skin` on every side where no corner moves (or a motion is not finite).
+    fn widened_ahead(
+        &self,
+        down: &[[f64; 3]],
+        up: &[[f64; 3]],
+        skin: f64,
+        slack: f64,
+    ) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let fastest = down.iter().chain(up).flatten().fold(0.0, |m: f64, v| m.max(v.abs()));
+        if !(fastest > 0.0 && fastest.is_finite()) {
+            let lo = self.lo.iter().map(|lo| lo.map(|v| v - skin)).collect();
+            let hi = self.hi.iter().map(|hi| hi.map(|v| v + skin)).collect();
+            return (lo, hi);
+        }
+        let scale = skin / fastest;
+        let lo = self.lo.iter().zip(down);
         let lo = lo.map(|(lo, m)| [0, 1, 2].map(|d| lo[d] - slack + (scale * m[d]).min(0.0)));
-        let hi = self.hi.iter().zip(&up);
+        let hi = self.hi.iter().zip(up);
         let hi = hi.map(|(hi, m)| [0, 1, 2].map(|d| hi[d] + slack + (scale * m[d]).max(0.0)));
         (lo.collect(), hi.collect())
     }
@@ -237,6 +248,26 @@ impl RunBoxes {
             widths.map(|(lo, hi)| (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max)).sum();
         sum / self.lo.len().max(1) as f64
     }
+}
+
+/// The bounds of the nodal velocity components at `t_b` over each run of `run` triangles of
+/// `surface`: the motion of the lower and of the upper corner of each run box per unit time.
+fn velocity_bounds(surface: &Surface, run: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let triangles = &surface.triangles;
+    (0..triangles.len().div_ceil(run))
+        .map(|r| {
+            let (mut down, mut up) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            let nodes = triangles[r * run..((r + 1) * run).min(triangles.len())].iter().flatten();
+            for &n in nodes {
+                let v = surface.v_b[n as usize];
+                for d in 0..3 {
+                    down[d] = down[d].min(v[d]);
+                    up[d] = up[d].max(v[d]);
+                }
+            }
+            (down, up)
+        })
+        .unzip()
 }
 
 #[cfg(test)]
@@ -266,7 +297,7 @@ mod tests {
             bvh.update(&surface);
             let fresh = Near::find(&mesh, &boxes, &bvh);
             assert!(!fresh.nodes.is_empty());
-            assert_eq!(skin.find(&mesh, &boxes, &bvh), fresh, "step {step}");
+            assert_eq!(skin.find(&mesh, &boxes, &bvh, &surface), fresh, "step {step}");
             if step == 11 {
                 // 0.11 h moved against a skin of half the mean shortest edge: one rebuild, the first.
                 assert_eq!(skin.rebuilds, 1, "step {step}");
@@ -278,7 +309,8 @@ mod tests {
 
     /// A sphere moving at a steady velocity and one circling an axis: the skin's near part equals
     /// a fresh traversal every step; the steady one keeps its pairs as many steps as a skin on
-    /// every side would (no more rebuilds) with far fewer pairs kept.
+    /// every side would (no more rebuilds) with far fewer pairs kept: from the first rebuild on
+    /// when its nodal velocities are given, from the second (the first motion seen) when not.
     #[test]
     fn the_skin_ahead_of_the_motion_keeps_fewer_pairs_for_as_long() {
         let mesh = cube_mesh(14, 0.3, 5);
@@ -286,42 +318,60 @@ mod tests {
         let boxes = NodeBoxes::build(&mesh, &adj);
         let rest = sphere([0.4, 0.45, 0.5], 0.2, 10);
         let h = 1.0 / 14.0;
-        let steady = |k: usize| [0.04 * h * k as f64, 0.01 * h * k as f64, 0.0];
-        let circling = |k: usize| {
-            let a = 0.05 * k as f64;
+        let dt = 0.01;
+        let steady = |k: f64| [0.04 * h * k, 0.01 * h * k, 0.0];
+        let circling = |k: f64| {
+            let a = 0.05 * k;
             [0.1 * (a.cos() - 1.0), 0.1 * a.sin(), 0.0]
         };
-        let run = |motion: &dyn Fn(usize) -> [f64; 3], steps: usize, ahead: bool| {
+        // `ahead`: widen ahead of the motion seen since the last call; `velocities`: give the
+        // nodal velocities (else zero).
+        let run = |motion: &dyn Fn(f64) -> [f64; 3], steps: usize, ahead: bool, velocities: bool| {
             let mut surface = rest.clone();
             let mut bvh = Bvh::build(&surface, 1e-4);
             let mut skin = NearSkin::new(&adj);
             let mut kept = Vec::new();
             for k in 1..=steps {
-                let m = motion(k);
+                let m = motion(k as f64);
                 let x: Vec<[f64; 3]> =
                     rest.x_b.iter().map(|p| [0, 1, 2].map(|d| p[d] + m[d])).collect();
-                surface.advance(0.01 * k as f64, &x, &vec![[0.0; 3]; x.len()]);
+                // The rigid motion's velocity at the step's end, by a central difference.
+                let (after, before) = (motion(k as f64 + 1e-4), motion(k as f64 - 1e-4));
+                let v = [0, 1, 2].map(|d| (after[d] - before[d]) / (2e-4 * dt));
+                let v = if velocities { v } else { [0.0; 3] };
+                surface.advance(dt * k as f64, &x, &vec![v; x.len()]);
                 bvh.update(&surface);
                 if !ahead {
-                    // No last call: every rebuild widens every side.
+                    // No last call: every rebuild widens by the velocities, or every side.
                     skin.last = RunBoxes::default();
                 }
                 let fresh = Near::find(&mesh, &boxes, &bvh);
-                assert_eq!(skin.find(&mesh, &boxes, &bvh), fresh, "step {k}");
+                assert_eq!(skin.find(&mesh, &boxes, &bvh, &surface), fresh, "step {k}");
                 kept.push(skin.kept.len());
             }
             (skin.rebuilds, kept)
         };
-        let (rebuilds, kept) = run(&steady, 60, true);
-        let (rebuilds_around, kept_around) = run(&steady, 60, false);
-        assert!(rebuilds > 2 && rebuilds <= rebuilds_around, "{rebuilds} vs {rebuilds_around}");
         let mean = |k: &[usize]| k.iter().sum::<usize>() as f64 / k.len() as f64;
+        let (rebuilds, kept) = run(&steady, 60, true, false);
+        let (rebuilds_around, kept_around) = run(&steady, 60, false, false);
+        assert!(rebuilds > 2 && rebuilds <= rebuilds_around, "{rebuilds} vs {rebuilds_around}");
         // The steps after the first rebuild ahead of the motion.
         let after = kept.iter().position(|&k| k != kept[0]).unwrap();
         let ratio = mean(&kept[after..]) / mean(&kept_around[after..]);
         assert!(ratio < 0.8, "kept {ratio} of the pairs");
-        let (turning, _) = run(&circling, 60, true);
-        assert!(turning > 2, "{turning} rebuilds");
+        // With the velocities, ahead from the first step on, by either estimate of the motion.
+        for ahead in [true, false] {
+            let (rebuilds_v, kept_v) = run(&steady, 60, ahead, true);
+            assert!(rebuilds_v <= rebuilds_around, "{rebuilds_v} vs {rebuilds_around}");
+            let ratio = mean(&kept_v) / mean(&kept_around);
+            assert!(ratio < 0.8, "ahead {ahead}: kept {ratio} of the pairs");
+            let first = kept_v[0] as f64 / kept_around[0] as f64;
+            assert!(first < 0.8, "ahead {ahead}: kept {first} of the pairs at the first step");
+        }
+        for velocities in [false, true] {
+            let (turning, _) = run(&circling, 60, true, velocities);
+            assert!(turning > 2, "{turning} rebuilds");
+        }
     }
 
     /// A finely meshed plate (runs of several triangles) and the same plate with its triangles
@@ -357,7 +407,7 @@ mod tests {
                 bvh.update(&surface);
                 let fresh = Near::find(&mesh, &boxes, &bvh);
                 assert!(!fresh.nodes.is_empty());
-                assert_eq!(skin.find(&mesh, &boxes, &bvh), fresh, "{label}, step {step}");
+                assert_eq!(skin.find(&mesh, &boxes, &bvh, &surface), fresh, "{label}, step {step}");
             }
             assert!(skin.run >= run, "{label}: runs of {}", skin.run);
             assert!(skin.rebuilds > 1, "{label}: {} rebuilds", skin.rebuilds);
