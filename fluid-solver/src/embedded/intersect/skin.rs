@@ -106,11 +106,8 @@ impl NearSkin {
         let same = self.run == last_run
             && self.last.lo.len() == runs.lo.len()
             && self.topology_version == bvh.topology_version;
-        let (down, up) = if same {
-            runs.motion_since(&self.last)
-        } else {
-            velocity_bounds(surface, self.run)
-        };
+        let (down, up) =
+            if same { runs.motion_since(&self.last) } else { velocity_bounds(surface, self.run) };
         (self.lo, self.hi) = runs.widened_ahead(&down, &up, self.skin, self.slack);
         self.triangles = bvh.len();
         self.topology_version = bvh.topology_version;
@@ -326,31 +323,32 @@ mod tests {
         };
         // `ahead`: widen ahead of the motion seen since the last call; `velocities`: give the
         // nodal velocities (else zero).
-        let run = |motion: &dyn Fn(f64) -> [f64; 3], steps: usize, ahead: bool, velocities: bool| {
-            let mut surface = rest.clone();
-            let mut bvh = Bvh::build(&surface, 1e-4);
-            let mut skin = NearSkin::new(&adj);
-            let mut kept = Vec::new();
-            for k in 1..=steps {
-                let m = motion(k as f64);
-                let x: Vec<[f64; 3]> =
-                    rest.x_b.iter().map(|p| [0, 1, 2].map(|d| p[d] + m[d])).collect();
-                // The rigid motion's velocity at the step's end, by a central difference.
-                let (after, before) = (motion(k as f64 + 1e-4), motion(k as f64 - 1e-4));
-                let v = [0, 1, 2].map(|d| (after[d] - before[d]) / (2e-4 * dt));
-                let v = if velocities { v } else { [0.0; 3] };
-                surface.advance(dt * k as f64, &x, &vec![v; x.len()]);
-                bvh.update(&surface);
-                if !ahead {
-                    // No last call: every rebuild widens by the velocities, or every side.
-                    skin.last = RunBoxes::default();
+        let run =
+            |motion: &dyn Fn(f64) -> [f64; 3], steps: usize, ahead: bool, velocities: bool| {
+                let mut surface = rest.clone();
+                let mut bvh = Bvh::build(&surface, 1e-4);
+                let mut skin = NearSkin::new(&adj);
+                let mut kept = Vec::new();
+                for k in 1..=steps {
+                    let m = motion(k as f64);
+                    let x: Vec<[f64; 3]> =
+                        rest.x_b.iter().map(|p| [0, 1, 2].map(|d| p[d] + m[d])).collect();
+                    // The rigid motion's velocity at the step's end, by a central difference.
+                    let (after, before) = (motion(k as f64 + 1e-4), motion(k as f64 - 1e-4));
+                    let v = [0, 1, 2].map(|d| (after[d] - before[d]) / (2e-4 * dt));
+                    let v = if velocities { v } else { [0.0; 3] };
+                    surface.advance(dt * k as f64, &x, &vec![v; x.len()]);
+                    bvh.update(&surface);
+                    if !ahead {
+                        // No last call: every rebuild widens by the velocities, or every side.
+                        skin.last = RunBoxes::default();
+                    }
+                    let fresh = Near::find(&mesh, &boxes, &bvh);
+                    assert_eq!(skin.find(&mesh, &boxes, &bvh, &surface), fresh, "step {k}");
+                    kept.push(skin.kept.len());
                 }
-                let fresh = Near::find(&mesh, &boxes, &bvh);
-                assert_eq!(skin.find(&mesh, &boxes, &bvh, &surface), fresh, "step {k}");
-                kept.push(skin.kept.len());
-            }
-            (skin.rebuilds, kept)
-        };
+                (skin.rebuilds, kept)
+            };
         let mean = |k: &[usize]| k.iter().sum::<usize>() as f64 / k.len() as f64;
         let (rebuilds, kept) = run(&steady, 60, true, false);
         let (rebuilds_around, kept_around) = run(&steady, 60, false, false);
